@@ -1,0 +1,93 @@
+#pragma once
+// Projection and visibility of a CAD model from a pose: the visible pieces of every edge
+// (back-face culling, occlusion by other faces, near-plane and image clipping), which side of
+// each projected edge the object is on, projected circles as ellipses, cylinder silhouettes.
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "epichead/vision/camera.h"
+#include "epichead/vision/cao_model.h"
+
+namespace epichead::vision {
+
+// Where the object is relative to a projected edge a->b in the image (x right, y down):
+// Left is the side of the normal (dy, -dx), i.e. on your left walking from a to b on screen.
+enum class ObjectSide { Left, Right, Both };
+
+enum class EdgeKind {
+  Contour,             // between a face toward the camera and one away from it (silhouette)
+  Crease,              // between two faces toward the camera, normals differ by > crease angle
+  Boundary,            // the border of an open surface (one face)
+  Wire,                // a free 3D line with no face
+  CylinderSilhouette,  // a limb of a cylinder
+};
+
+// One visible piece of a model edge (an edge partly hidden yields several pieces).
+struct VisibleEdge {
+  int edge = -1;  // index into CadModel::edges, or into CadModel::cylinders for silhouettes
+  EdgeKind kind = EdgeKind::Contour;
+  ObjectSide side = ObjectSide::Both;
+  Eigen::Vector3d a_obj, b_obj;  // the visible piece, object frame
+  Eigen::Vector3d a_cam, b_cam;  // the same, camera frame
+  Eigen::Vector2d a_px, b_px;    // projected end points (with distortion)
+  double s0 = 0, s1 = 1;         // the piece as a fraction of the full model edge (a = v0 + s0 (v1 - v0))
+};
+
+// A model circle projected to an ellipse (pinhole, without distortion):
+// p^T conic p = 0 for homogeneous pixel p.
+struct VisibleEllipse {
+  int circle = -1;  // index into CadModel::circles
+  Eigen::Matrix3d conic_px = Eigen::Matrix3d::Zero();
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double semi_major_px = 0, semi_minor_px = 0;
+  double angle_rad = 0;  // of the major axis from the image x axis
+  bool facing_camera = true;  // the circle's normal points toward the camera
+};
+
+struct VisibilityOptions {
+  // Edges between faces whose normals differ by less than this make no image edge (facets of
+  // a curved surface) and are left out unless they lie on the silhouette.
+  double crease_angle_rad = 20.0 * 3.14159265358979323846 / 180.0;
+  double near_m = 0.01;        // near clipping plane
+  double margin_px = 0;        // clip edges to the image shrunk by this margin
+  double min_length_px = 2.0;  // visible pieces shorter than this are dropped
+};
+
+struct VisibleModel {
+  std::vector<VisibleEdge> edges;
+  std::vector<VisibleEllipse> ellipses;
+  void clear() { edges.clear(); ellipses.clear(); }
+};
+
+// Computes visibility for one model and camera. Holds its buffers, so repeated calls allocate
+// nothing once `out` has grown to its working size.
+class Visibility {
+ public:
+  Visibility(const CadModel& model, const Camera& camera, const VisibilityOptions& options = {});
+  void compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out);
+  const VisibilityOptions& options() const { return options_; }
+
+ private:
+  const CadModel* model_;
+  Camera camera_;
+  VisibilityOptions options_;
+  // Flat per-triangle data in the object frame, and per-call scratch in the camera frame.
+  struct Triangle { Eigen::Vector3d p0, p1, p2; int face; };
+  std::vector<Triangle> triangles_;
+  std::vector<Eigen::Vector3d> vertices_cam_;
+  std::vector<Eigen::Vector3d> tri_cam_;      // 3 per triangle
+  std::vector<Eigen::Vector4d> tri_bbox_px_;  // per triangle: normalised-image bounding box
+  std::vector<unsigned char> tri_valid_;
+  std::vector<unsigned char> face_front_;
+  std::vector<std::pair<double, double>> hidden_;  // scratch intervals
+  double xn_min_ = 0, xn_max_ = 0, yn_min_ = 0, yn_max_ = 0;  // image bounds, normalised
+};
+
+// Convenience: one call, plain values out.
+VisibleModel compute_visibility(const CadModel& model, const Camera& camera,
+                                const Eigen::Isometry3d& cam_T_obj,
+                                const VisibilityOptions& options = {});
+
+}  // namespace epichead::vision
