@@ -1,0 +1,35 @@
+#pragma once
+// The project's benchmarks, run by `epichead bench`. A benchmark registers a factory that does
+// its set-up (allocation allowed there) and returns the body of one iteration; the harness warms
+// the body up, then times it and counts the heap allocations it makes.
+//
+//   static const epichead::bench::Registration reg{"visibility_teabox", [] {
+//     auto state = std::make_shared<...>(...);            // set-up
+//     return [state] { state->vis.compute(pose, state->out); };  // one iteration
+//   }};
+//
+// Keep results observable (write into state) so the optimiser cannot remove the work.
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace epichead::bench {
+
+using Iteration = std::function<void()>;
+using Factory = std::function<Iteration()>;
+
+struct Benchmark {
+  std::string name;
+  Factory make;
+};
+
+std::vector<Benchmark>& registry();
+
+struct Registration {
+  Registration(std::string name, Factory make) { registry().push_back({std::move(name), std::move(make)}); }
+};
+
+// Heap allocations made by this process so far (operator new, all threads).
+unsigned long long allocation_count();
+
+}  // namespace epichead::bench
