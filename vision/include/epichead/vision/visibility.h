@@ -77,9 +77,11 @@ class Visibility {
   struct Triangle { Eigen::Vector3d p0, p1, p2; int face; };
   std::vector<Triangle> triangles_;
   std::vector<Eigen::Vector3d> vertices_cam_;
-  std::vector<Eigen::Vector3d> tri_cam_;      // 3 per triangle
-  std::vector<Eigen::Vector4d> tri_bbox_px_;  // per triangle: normalised-image bounding box
-  std::vector<unsigned char> tri_valid_;
+  std::vector<Eigen::Vector3d> tri_cam_;  // 3 per triangle
+  // Per triangle, structure of arrays for a vectorised rejection test: bounding box in
+  // normalised image coordinates (empty box = not an occluder this call).
+  std::vector<float> tri_x0_, tri_x1_, tri_y0_, tri_y1_;
+  std::vector<int> candidates_;  // scratch: triangles whose box meets the edge's
   std::vector<unsigned char> face_front_;
   std::vector<std::pair<double, double>> hidden_;  // scratch intervals
   double xn_min_ = 0, xn_max_ = 0, yn_min_ = 0, yn_max_ = 0;  // image bounds, normalised

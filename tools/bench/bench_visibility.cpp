@@ -1,0 +1,65 @@
+// Benchmarks visibility_teabox and visibility_300: one full visibility computation.
+#include <cmath>
+#include <memory>
+
+#include "bench/bench.h"
+#include "epichead/vision/visibility.h"
+
+namespace {
+
+using namespace epichead::vision;
+
+Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Eigen::Isometry3d obj_T_cam = Eigen::Isometry3d::Identity();
+  obj_T_cam.linear() << x, z.cross(x), z;
+  obj_T_cam.translation() = eye;
+  return obj_T_cam.inverse();
+}
+
+// Axis-aligned box as a closed model: 8 vertices, 6 faces CCW from outside.
+void add_box(RawModel& raw, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const int b = static_cast<int>(raw.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    raw.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) raw.face_loops.push_back({b + f[0], b + f[1], b + f[2], b + f[3]});
+}
+
+struct VisibilityBench {
+  CadModel model;
+  Camera camera{640, 480, {600, 600, 320, 240}};
+  std::unique_ptr<Visibility> visibility;
+  VisibleModel out;
+  Eigen::Isometry3d pose;
+};
+
+// The teabox of ../shared/data/teabox (0.165 x 0.068 x 0.08 m) at its frame-0 pose.
+const epichead::bench::Registration teabox{"visibility_teabox", [] {
+  auto b = std::make_shared<VisibilityBench>();
+  RawModel raw;
+  add_box(raw, {0, 0, -0.08}, {0.165, 0.068, 0});
+  b->model = *build_model(raw, "teabox");
+  b->camera = Camera(640, 480, {839.2147, 839.44555, 325.66776, 243.69727});
+  b->pose = Eigen::Isometry3d::Identity();
+  b->pose.linear() = Eigen::Quaterniond(0.479187837, 0.712274104, 0.452593677, -0.241254183).normalized().toRotationMatrix();
+  b->pose.translation() = Eigen::Vector3d(-0.070345888, -0.084143195, 0.448947131);
+  b->visibility = std::make_unique<Visibility>(b->model, b->camera);
+  return [b] { b->visibility->compute(b->pose, b->out); };
+}};
+
+// 25 boxes on a 5 x 5 grid (300 edges, 150 faces), seen obliquely so that they hide each other.
+const epichead::bench::Registration grid300{"visibility_300", [] {
+  auto b = std::make_shared<VisibilityBench>();
+  RawModel raw;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      add_box(raw, {0.12 * i, 0.12 * j, 0}, {0.12 * i + 0.08, 0.12 * j + 0.08, 0.05 + 0.02 * ((i + j) % 3)});
+  b->model = *build_model(raw, "grid300");
+  b->pose = look_at({-0.5, -0.4, 0.45}, {0.26, 0.26, 0.03});
+  b->visibility = std::make_unique<Visibility>(b->model, b->camera);
+  return [b] { b->visibility->compute(b->pose, b->out); };
+}};
+
+}  // namespace
