@@ -14,8 +14,8 @@ namespace epichead::vision {
 // A planar polygon, vertices counter-clockwise seen from outside.
 struct ModelFace {
   std::vector<int> vertices;                 // indices into CadModel::vertices, CCW from outside
-  Eigen::Vector3d normal_obj{0, 0, 1};       // outward unit normal (Newell's method)
-  double offset_m = 0;                       // plane: normal_obj . X = offset_m
+  Eigen::Vector3d normal_obj{0, 0, 1};       // outward unit normal (Newell's method); zero for a zero-area face, which has no triangles
+  double offset_m = 0;                       // plane: normal_obj . X = offset_m (0 for a degenerate face)
   std::vector<std::array<int, 3>> triangles; // ear-clipped triangulation (vertex indices), for occlusion
 };
 

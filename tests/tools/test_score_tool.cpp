@@ -1,0 +1,228 @@
+// `epichead score` through the built program, on a tiny synthetic image sequence of a cube.
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "epichead/vision/sequence.h"
+#include "epichead/vision/stamped_pose.h"
+
+using namespace epichead::vision;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int counter = 0;
+    path = fs::temp_directory_path() /
+           ("epichead_test_score_tool_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `epichead score <args>` (arguments already shell-quoted) and captures both streams.
+Run score(const TempDir& tmp, const std::string& args) {
+  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
+  const std::string command = "'" + std::string(EPICHEAD_BIN) + "' score " + args + " > '" + out + "' 2> '" + err + "'";
+  const int status = std::system(command.c_str());
+  Run r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+StampedPose pose_at(int frame) {
+  StampedPose p;
+  p.frame = frame;
+  p.t_s = frame / 30.0;
+  p.cam_T_obj = Eigen::Translation3d(0.005 * frame, 0.01, 0.5) * Eigen::AngleAxisd(0.4 + 0.05 * frame, Eigen::Vector3d(1, 1, 0).normalized());
+  return p;
+}
+
+constexpr int kFrames = 5;
+
+// camera.yaml, model.cao (a cube), five PNG frames with frames.csv, init.csv and gt.csv.
+std::string make_sequence(const TempDir& tmp, bool with_gt = true) {
+  const fs::path dir = tmp.path / "seq";
+  fs::create_directories(dir / "frames");
+  const std::string fixtures = std::string(EPICHEAD_TEST_DATA) + "/seq";
+  fs::copy_file(fixtures + "/camera.yaml", dir / "camera.yaml");
+  fs::copy_file(fixtures + "/cube.cao", dir / "model.cao");
+  std::vector<FrameEntry> frames;
+  std::vector<StampedPose> gt;
+  for (int i = 0; i < kFrames; ++i) {
+    const std::string name = "frames/" + std::to_string(i) + ".png";
+    REQUIRE(cv::imwrite((dir / name).string(), cv::Mat(120, 160, CV_8UC3, cv::Scalar(20 * i, 100, 200))));
+    frames.push_back({i, i / 30.0, name});
+    gt.push_back(pose_at(i));
+  }
+  REQUIRE(write_frames_csv((dir / "frames.csv").string(), frames).has_value());
+  REQUIRE(write_pose_csv((dir / "init.csv").string(), {gt[0]}).has_value());
+  if (with_gt) REQUIRE(write_pose_csv((dir / "gt.csv").string(), gt).has_value());
+  return dir.string();
+}
+
+// Ground truth shifted by 20 mm, with frame 2 missing.
+std::string make_estimates(const TempDir& tmp) {
+  std::vector<StampedPose> est;
+  for (int i = 0; i < kFrames; ++i) {
+    if (i == 2) continue;
+    StampedPose p = pose_at(i);
+    p.cam_T_obj.translation().x() += 0.020;
+    p.status = "tracked";
+    est.push_back(p);
+  }
+  const std::string path = tmp / "poses.csv";
+  REQUIRE(write_pose_csv(path, est).has_value());
+  return path;
+}
+
+bool one_line(const std::string& s, const std::string& prefix) {
+  return s.rfind(prefix, 0) == 0 && s.find('\n') == s.size() - 1;
+}
+
+}  // namespace
+
+TEST_CASE("score --json prints one object with counts, rate, losses and error statistics") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)) + " --json");
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j.at("frames") == kFrames);
+  CHECK(j.at("present") == kFrames - 1);
+  CHECK(j.at("succeeded") == kFrames - 1);
+  CHECK(j.at("success_rate").get<double>() == Approx(0.8));
+  CHECK(j.at("losses") == 1);
+  for (const char* key : {"rotation_deg", "translation_mm", "reprojection_px"})
+    for (const char* stat : {"mean", "median", "p95"}) CHECK(j.at(key).at(stat).is_number());
+  CHECK(j.at("translation_mm").at("mean").get<double>() == Approx(20.0).epsilon(1e-6));
+  CHECK(j.at("rotation_deg").at("p95").get<double>() == Approx(0).margin(1e-5));
+  CHECK(j.at("reprojection_px").at("median").get<double>() > 1.0);
+}
+
+TEST_CASE("score prints a human summary by default") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)));
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.out, Catch::Contains("success rate") && Catch::Contains("80.0 %") && Catch::Contains("losses") &&
+                        Catch::Contains("translation_mm") && Catch::Contains("20.000"));
+  CHECK(r.err.empty());
+}
+
+TEST_CASE("score --per-frame writes one row per ground-truth frame") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)) + " --per-frame " + q(tmp / "per_frame.csv"));
+  REQUIRE(r.exit_code == 0);
+  std::ifstream in(tmp / "per_frame.csv");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  REQUIRE(lines.size() == kFrames + 1);
+  CHECK(lines[0] == "frame,present,success,rotation_deg,translation_mm,reprojection_px");
+  CHECK(lines[3] == "2,0,0,,,");
+  CHECK_THAT(lines[1], Catch::StartsWith("0,1,1,") && Catch::Contains(",20.000000,"));
+
+  const Run bad = score(tmp, q(seq) + " " + q(make_estimates(tmp)) + " --per-frame " + q(tmp / "no/such/dir.csv"));
+  CHECK(bad.exit_code == 1);
+  CHECK(one_line(bad.err, "epichead score: "));
+}
+
+TEST_CASE("score --sym-axis removes the turn about the given axis") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  std::vector<StampedPose> est;
+  for (int i = 0; i < kFrames; ++i) {
+    StampedPose p = pose_at(i);
+    p.cam_T_obj = p.cam_T_obj * Eigen::AngleAxisd(50 * std::numbers::pi / 180, Eigen::Vector3d::UnitY());
+    est.push_back(p);
+  }
+  REQUIRE(write_pose_csv(tmp / "turned.csv", est).has_value());
+  const Run plain = score(tmp, q(seq) + " " + q(tmp / "turned.csv") + " --json");
+  REQUIRE(plain.exit_code == 0);
+  CHECK(nlohmann::json::parse(plain.out).at("succeeded") == 0);
+  const Run sym = score(tmp, q(seq) + " " + q(tmp / "turned.csv") + " --json --sym-axis 0,2,0");
+  REQUIRE(sym.exit_code == 0);
+  const auto j = nlohmann::json::parse(sym.out);
+  CHECK(j.at("succeeded") == kFrames);
+  CHECK(j.at("rotation_deg").at("mean").get<double>() == Approx(0).margin(1e-5));
+}
+
+TEST_CASE("score refuses a sequence without gt.csv") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp, false);
+  const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)));
+  CHECK(r.exit_code == 1);
+  CHECK(r.err == "epichead score: " + seq + " has no gt.csv (no ground truth to score against)\n");
+  CHECK(r.out.empty());
+}
+
+TEST_CASE("score reports bad input in one line and exits non-zero") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  const std::string poses = make_estimates(tmp);
+  for (const char* axis : {"1,2", "a,b,c", "0,0,0", "1,2,3,4", "1,nan,0", "1,2,"}) {
+    INFO("axis " << axis);
+    const Run r = score(tmp, q(seq) + " " + q(poses) + " --sym-axis " + q(axis));
+    CHECK(r.exit_code == 1);
+    CHECK(one_line(r.err, "epichead score: --sym-axis '" + std::string(axis) + "'"));
+  }
+  {
+    std::ofstream(tmp / "broken.csv") << "frame,t_s,tx,ty,tz,qw,qx,qy,qz\n0,0,0,0,1,1,0,0,0\n1,0.1,0,0,one,1,0,0,0\n";
+    const Run r = score(tmp, q(seq) + " " + q(tmp / "broken.csv"));
+    CHECK(r.exit_code == 1);
+    CHECK(r.err == "epichead score: " + (tmp / "broken.csv") + ":3: tz is not a number ('one')\n");
+  }
+  {
+    const Run r = score(tmp, q(tmp / "nowhere") + " " + q(poses));
+    CHECK(r.exit_code == 1);
+    CHECK(one_line(r.err, "epichead score: " + (tmp / "nowhere")));
+  }
+  {
+    fs::remove(fs::path(seq) / "frames/3.png");
+    const Run r = score(tmp, q(seq) + " " + q(poses));
+    CHECK(r.exit_code == 1);
+    CHECK(one_line(r.err, "epichead score: " + seq + "/frames/3.png: frame file not found"));
+  }
+}
+
+TEST_CASE("score --help describes the command and exits 0") {
+  TempDir tmp;
+  const Run r = score(tmp, "--help");
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.out, Catch::Contains("--sym-axis") && Catch::Contains("--per-frame") && Catch::Contains("--json"));
+}

@@ -1,0 +1,305 @@
+// Camera: OpenCV's distortion model exactly, its Jacobian and inverse, and the YAML reader's
+// error paths.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <opencv2/calib3d.hpp>
+
+#include "epichead/vision/camera.h"
+
+using epichead::vision::Camera;
+using epichead::vision::Distortion;
+using epichead::vision::Intrinsics;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh directory under the system temp dir, removed at the end of the test.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int counter = 0;
+    path = fs::temp_directory_path() /
+           ("epichead_test_camera_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) const {
+    const fs::path p = path / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+};
+
+// Wide-angle barrel distortion with tangential terms: the image corner (r ~ 0.8) lies close to
+// the radius where the model folds over (~0.89), so the inverse has to work hard there.
+Camera strong_camera() {
+  return Camera(640, 480, Intrinsics{500.0, 505.0, 322.5, 237.25}, Distortion{-0.35, 0.12, 0.002, -0.001, -0.02});
+}
+
+std::string yaml(const std::string& width, const std::string& height, const std::string& k_rows_cols_data,
+                 const std::string& d_rows_cols_data) {
+  std::string s = "%YAML:1.0\n---\n";
+  if (!width.empty()) s += "image_width: " + width + "\n";
+  if (!height.empty()) s += "image_height: " + height + "\n";
+  if (!k_rows_cols_data.empty()) s += "camera_matrix: " + k_rows_cols_data + "\n";
+  if (!d_rows_cols_data.empty()) s += "distortion_coefficients: " + d_rows_cols_data + "\n";
+  return s;
+}
+
+std::string matrix(int rows, int cols, const std::string& data) {
+  return "!!opencv-matrix\n   rows: " + std::to_string(rows) + "\n   cols: " + std::to_string(cols) +
+         "\n   dt: d\n   data: [ " + data + " ]";
+}
+
+const std::string kGoodK = matrix(3, 3, "500., 0., 320., 0., 510., 240., 0., 0., 1.");
+const std::string kGoodD = matrix(1, 5, "-0.1, 0.01, 0.001, 0.002, 0.0005");
+
+std::string load_error(const TempDir& dir, const std::string& text) {
+  const std::string path = dir.write("camera.yaml", text);
+  auto cam = Camera::load(path);
+  REQUIRE_FALSE(cam.has_value());
+  return cam.error();
+}
+
+}  // namespace
+
+TEST_CASE("pixel_to_normalized inverts normalized_to_pixel over the whole image under strong distortion") {
+  const Camera cam = strong_camera();
+  REQUIRE(cam.has_distortion());
+  double worst_px = 0;
+  for (double v = -0.5; v <= 479.5; v += 4.0) {
+    for (double u = -0.5; u <= 639.5; u += 4.0) {
+      const Eigen::Vector2d px(u, v);
+      const Eigen::Vector2d back = cam.normalized_to_pixel(cam.pixel_to_normalized(px));
+      worst_px = std::max(worst_px, (back - px).norm());
+    }
+  }
+  CHECK(worst_px < 1e-6);
+}
+
+TEST_CASE("normalized_to_pixel then pixel_to_normalized returns the same normalised point") {
+  const Camera cam = strong_camera();
+  double worst = 0;
+  for (double y = -0.45; y <= 0.45; y += 0.03)
+    for (double x = -0.6; x <= 0.6; x += 0.03) {
+      const Eigen::Vector2d xn(x, y);
+      worst = std::max(worst, (cam.pixel_to_normalized(cam.normalized_to_pixel(xn)) - xn).norm());
+    }
+  CHECK(worst < 1e-10);
+}
+
+TEST_CASE("project agrees with cv::projectPoints") {
+  const Camera cam = strong_camera();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> xy(-0.5, 0.5), z(0.8, 3.0);
+  std::vector<cv::Point3d> points;
+  for (int i = 0; i < 200; ++i) {
+    const double zz = z(rng);
+    points.emplace_back(xy(rng) * zz, xy(rng) * zz, zz);
+  }
+  const auto& k = cam.intrinsics();
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
+  const auto& d = cam.distortion();
+  const cv::Mat D = (cv::Mat_<double>(1, 5) << d[0], d[1], d[2], d[3], d[4]);
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, expected);
+  double worst = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d px = cam.project({points[i].x, points[i].y, points[i].z});
+    worst = std::max(worst, (px - Eigen::Vector2d(expected[i].x, expected[i].y)).norm());
+  }
+  CHECK(worst < 1e-9);
+}
+
+TEST_CASE("pixel_to_normalized agrees with a tightly converged cv::undistortPoints") {
+  const Camera cam(640, 480, Intrinsics{600, 600, 320, 240}, Distortion{-0.2, 0.05, 0.001, -0.001, 0.0});
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << 600, 0, 320, 0, 600, 240, 0, 0, 1);
+  const cv::Mat D = (cv::Mat_<double>(1, 5) << -0.2, 0.05, 0.001, -0.001, 0.0);
+  std::vector<cv::Point2d> px{{0, 0}, {639, 479}, {100, 400}, {320, 240}, {600, 20}}, out;
+  cv::undistortPoints(px, out, K, D, cv::noArray(), cv::noArray(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 1000, 1e-15));
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const Eigen::Vector2d xn = cam.pixel_to_normalized({px[i].x, px[i].y});
+    CHECK(xn.x() == Approx(out[i].x).margin(1e-8));
+    CHECK(xn.y() == Approx(out[i].y).margin(1e-8));
+  }
+}
+
+TEST_CASE("pixel_to_normalized stays finite far outside the image, where the model folds over") {
+  for (const Camera& cam : {strong_camera(), Camera(640, 480, Intrinsics{500, 500, 320, 240}, Distortion{0.4, 0.3, 0, 0, 0.1})}) {
+    for (const Eigen::Vector2d& px : {Eigen::Vector2d(1e6, -1e6), Eigen::Vector2d(-5000, 3000), Eigen::Vector2d(2000, 240),
+                                     Eigen::Vector2d(1e12, 1e12)}) {
+      const Eigen::Vector2d xn = cam.pixel_to_normalized(px);
+      CHECK(xn.allFinite());
+    }
+  }
+}
+
+TEST_CASE("normalized_to_pixel_jacobian matches finite differences") {
+  const Camera cam = strong_camera();
+  const double h = 1e-6;
+  for (const Eigen::Vector2d& xn : {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.3, -0.2), Eigen::Vector2d(-0.6, 0.45),
+                                   Eigen::Vector2d(0.05, 0.4)}) {
+    const Eigen::Matrix2d J = cam.normalized_to_pixel_jacobian(xn);
+    Eigen::Matrix2d numeric;
+    for (int c = 0; c < 2; ++c) {
+      Eigen::Vector2d d = Eigen::Vector2d::Zero();
+      d[c] = h;
+      numeric.col(c) = (cam.normalized_to_pixel(xn + d) - cam.normalized_to_pixel(xn - d)) / (2 * h);
+    }
+    CHECK((J - numeric).norm() < 1e-4);  // pixels per unit: J is ~500
+  }
+  const Camera plain(640, 480, Intrinsics{500, 510, 320, 240});
+  const Eigen::Matrix2d J = plain.normalized_to_pixel_jacobian({0.2, 0.1});
+  CHECK(J(0, 0) == 500);
+  CHECK(J(1, 1) == 510);
+  CHECK(J(0, 1) == 0);
+}
+
+TEST_CASE("project returns NaN for points at or behind the camera") {
+  const Camera cam = strong_camera();
+  CHECK_FALSE(cam.project({0.1, 0.1, 0}).allFinite());
+  CHECK_FALSE(cam.project({0.1, 0.1, -1}).allFinite());
+  const Eigen::Vector3d ray = cam.unproject(cam.project({0.2, -0.1, 2.0}));
+  CHECK(ray.z() == 1);
+  CHECK(ray.x() == Approx(0.1).margin(1e-12));
+  CHECK(ray.y() == Approx(-0.05).margin(1e-12));
+}
+
+TEST_CASE("in_image uses pixel centres 0..width-1 and the margin") {
+  const Camera cam(640, 480, Intrinsics{500, 500, 320, 240});
+  CHECK(cam.in_image({0, 0}));
+  CHECK(cam.in_image({639, 479}));
+  CHECK_FALSE(cam.in_image({639.5, 10}));
+  CHECK_FALSE(cam.in_image({-0.1, 10}));
+  CHECK_FALSE(cam.in_image({5, 10}, 10));
+  CHECK(cam.in_image({10, 10}, 10));
+  CHECK_FALSE(cam.in_image({std::nan(""), 10}));
+}
+
+TEST_CASE("the constructor rejects non-positive sizes and focal lengths") {
+  CHECK_THROWS_AS(Camera(0, 480, Intrinsics{500, 500, 320, 240}), std::invalid_argument);
+  CHECK_THROWS_AS(Camera(640, -1, Intrinsics{500, 500, 320, 240}), std::invalid_argument);
+  CHECK_THROWS_AS(Camera(640, 480, Intrinsics{0, 500, 320, 240}), std::invalid_argument);
+  CHECK_THROWS_AS(Camera(640, 480, Intrinsics{500, -2, 320, 240}), std::invalid_argument);
+}
+
+TEST_CASE("save then load gives back the same camera exactly") {
+  TempDir dir;
+  const Camera cam = strong_camera();
+  const std::string path = (dir.path / "cam.yaml").string();
+  REQUIRE(cam.save(path).has_value());
+  auto back = Camera::load(path);
+  REQUIRE(back.has_value());
+  CHECK(back->width_px() == 640);
+  CHECK(back->height_px() == 480);
+  CHECK(back->intrinsics().fx_px == cam.intrinsics().fx_px);
+  CHECK(back->intrinsics().fy_px == cam.intrinsics().fy_px);
+  CHECK(back->intrinsics().cx_px == cam.intrinsics().cx_px);
+  CHECK(back->intrinsics().cy_px == cam.intrinsics().cy_px);
+  CHECK(back->distortion() == cam.distortion());
+  CHECK(back->K() == cam.K());
+}
+
+TEST_CASE("save reports a directory that does not exist") {
+  const Camera cam = strong_camera();
+  auto r = cam.save("/nonexistent-dir-epichead/cam.yaml");
+  REQUIRE_FALSE(r.has_value());
+  CHECK_THAT(r.error(), Catch::Contains("/nonexistent-dir-epichead/cam.yaml"));
+}
+
+TEST_CASE("the teabox camera.yaml loads") {
+  auto cam = Camera::load(std::string(EPICHEAD_SHARED_DATA) + "/teabox/camera.yaml");
+  REQUIRE(cam.has_value());
+  CHECK(cam->width_px() == 640);
+  CHECK(cam->height_px() == 480);
+  CHECK(cam->intrinsics().fx_px == Approx(839.2147));
+  CHECK(cam->intrinsics().cy_px == Approx(243.69727));
+  CHECK_FALSE(cam->has_distortion());
+}
+
+TEST_CASE("distortion_coefficients with 4 values, none, or a column are accepted") {
+  TempDir dir;
+  SECTION("1x4 means k3 = 0") {
+    auto cam = Camera::load(dir.write("c.yaml", yaml("640", "480", kGoodK, matrix(1, 4, "-0.1, 0.01, 0.001, 0.002"))));
+    REQUIRE(cam.has_value());
+    CHECK(cam->distortion() == Distortion{-0.1, 0.01, 0.001, 0.002, 0});
+  }
+  SECTION("5x1") {
+    auto cam = Camera::load(dir.write("c.yaml", yaml("640", "480", kGoodK, matrix(5, 1, "-0.1, 0.01, 0.001, 0.002, 0.5"))));
+    REQUIRE(cam.has_value());
+    CHECK(cam->distortion()[4] == 0.5);
+  }
+  SECTION("empty") {
+    auto cam = Camera::load(dir.write("c.yaml", yaml("640", "480", kGoodK, matrix(0, 0, ""))));
+    REQUIRE(cam.has_value());
+    CHECK_FALSE(cam->has_distortion());
+  }
+}
+
+TEST_CASE("camera YAML errors name the file and the field") {
+  TempDir dir;
+  SECTION("missing file") {
+    auto cam = Camera::load((dir.path / "nope.yaml").string());
+    REQUIRE_FALSE(cam.has_value());
+    CHECK_THAT(cam.error(), Catch::Contains("nope.yaml") && Catch::Contains("cannot open"));
+  }
+  SECTION("not YAML") {
+    CHECK_THAT(load_error(dir, "this { is [ not : yaml ]]] :\n\t- -\n"), Catch::Contains("camera.yaml: "));
+    CHECK_THAT(load_error(dir, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)), Catch::Contains("camera.yaml: "));
+    CHECK_THAT(load_error(dir, ""), Catch::Contains("camera.yaml: "));
+  }
+  SECTION("missing fields") {
+    CHECK_THAT(load_error(dir, yaml("640", "480", "", kGoodD)), Catch::Contains("camera.yaml: missing field 'camera_matrix'"));
+    CHECK_THAT(load_error(dir, yaml("", "480", kGoodK, kGoodD)), Catch::Contains("camera.yaml: missing field 'image_width'"));
+    CHECK_THAT(load_error(dir, yaml("640", "", kGoodK, kGoodD)), Catch::Contains("camera.yaml: missing field 'image_height'"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, "")),
+               Catch::Contains("camera.yaml: missing field 'distortion_coefficients'"));
+  }
+  SECTION("camera_matrix shape and content") {
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 2, "1, 0, 0, 1, 0, 0"), kGoodD)),
+               Catch::Contains("camera.yaml: camera_matrix must be 3x3, got 3x2"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", "42", kGoodD)), Catch::Contains("camera.yaml: camera_matrix must be"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "0., 0., 320., 0., 510., 240., 0., 0., 1."), kGoodD)),
+               Catch::Contains("camera.yaml: fx must be positive"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "500., 0., 320., 0., -510., 240., 0., 0., 1."), kGoodD)),
+               Catch::Contains("camera.yaml: fy must be positive"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "500., 0., .nan, 0., 510., 240., 0., 0., 1."), kGoodD)),
+               Catch::Contains("camera.yaml: camera_matrix has a non-finite value"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "500., 0., .inf, 0., 510., 240., 0., 0., 1."), kGoodD)),
+               Catch::Contains("camera.yaml: camera_matrix has a non-finite value"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "500., 3., 320., 0., 510., 240., 0., 0., 1."), kGoodD)),
+               Catch::Contains("skew"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", matrix(3, 3, "500., 0., 320., 0., 510., 240., 0., 0., 2."), kGoodD)),
+               Catch::Contains("camera.yaml: camera_matrix must have the form"));
+  }
+  SECTION("image sizes") {
+    CHECK_THAT(load_error(dir, yaml("0", "480", kGoodK, kGoodD)), Catch::Contains("camera.yaml: image_width must be positive"));
+    CHECK_THAT(load_error(dir, yaml("640", "-480", kGoodK, kGoodD)), Catch::Contains("camera.yaml: image_height must be positive"));
+    CHECK_THAT(load_error(dir, yaml("640.5", "480", kGoodK, kGoodD)), Catch::Contains("camera.yaml: image_width must be a whole number"));
+    CHECK_THAT(load_error(dir, yaml("wide", "480", kGoodK, kGoodD)), Catch::Contains("camera.yaml: image_width must be a number"));
+  }
+  SECTION("distortion models we do not have") {
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, matrix(1, 8, "0.1, 0, 0, 0, 0, 0.2, 0, 0"))),
+               Catch::Contains("camera.yaml: distortion_coefficients has 8 values"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, matrix(1, 14, "0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0"))),
+               Catch::Contains("distortion_coefficients has 14 values"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, matrix(1, 3, "0.1, 0, 0"))),
+               Catch::Contains("camera.yaml: distortion_coefficients must have 0, 4 or 5 values, got 3"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, matrix(2, 3, "0.1, 0, 0, 0, 0, 0"))),
+               Catch::Contains("camera.yaml: distortion_coefficients must be a row or column vector, got 2x3"));
+    CHECK_THAT(load_error(dir, yaml("640", "480", kGoodK, matrix(1, 5, "0.1, 0, .nan, 0, 0"))),
+               Catch::Contains("camera.yaml: distortion_coefficients has a non-finite value"));
+  }
+}

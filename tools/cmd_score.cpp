@@ -1,0 +1,152 @@
+// `epichead score SEQ POSES.csv [--json] [--sym-axis X,Y,Z] [--per-frame FILE.csv]`: scores a
+// tracker's poses against the sequence's gt.csv (rotation, translation and reprojection errors,
+// 5 cm / 5 degree success, losses).
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <expected>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "command.h"
+#include "epichead/vision/score.h"
+#include "epichead/vision/sequence.h"
+#include "epichead/vision/stamped_pose.h"
+
+namespace epichead::tools {
+namespace {
+
+using vision::ErrorStats;
+using vision::ScoreSummary;
+
+// "X,Y,Z" -> a unit vector, or the reason it is not one.
+std::expected<Eigen::Vector3d, std::string> parse_axis(const std::string& text) {
+  std::stringstream in(text);
+  std::string part;
+  std::vector<double> values;
+  while (std::getline(in, part, ',')) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(part, &used);
+      while (used < part.size() && part[used] == ' ') ++used;
+      if (used != part.size() || !std::isfinite(v)) throw std::invalid_argument(part);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      return std::unexpected("--sym-axis '" + text + "': '" + part + "' is not a finite number");
+    }
+  }
+  if (values.size() != 3 || (!text.empty() && text.back() == ','))
+    return std::unexpected("--sym-axis '" + text + "': expected three numbers X,Y,Z");
+  const Eigen::Vector3d axis(values[0], values[1], values[2]);
+  if (axis.norm() < 1e-9) return std::unexpected("--sym-axis '" + text + "': the axis must not be zero");
+  return axis.normalized();
+}
+
+nlohmann::json stats_json(const ErrorStats& s) {
+  // NaN (no frame with an estimate) becomes null in JSON.
+  return {{"mean", s.mean}, {"median", s.median}, {"p95", s.p95}};
+}
+
+std::string number_or_empty(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+std::expected<void, std::string> write_per_frame(const std::string& path, const ScoreSummary& summary) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) return std::unexpected(path + ": cannot open for writing");
+  std::fprintf(f, "frame,present,success,rotation_deg,translation_mm,reprojection_px\n");
+  for (const auto& s : summary.per_frame)
+    std::fprintf(f, "%d,%d,%d,%s,%s,%s\n", s.frame, s.present ? 1 : 0, s.success ? 1 : 0,
+                 number_or_empty(s.rotation_deg).c_str(), number_or_empty(s.translation_mm).c_str(),
+                 number_or_empty(s.reprojection_px).c_str());
+  if (std::fclose(f) != 0) return std::unexpected(path + ": write error");
+  return {};
+}
+
+void print_human(const std::string& seq_dir, const ScoreSummary& s, int ignored) {
+  std::printf("sequence         %s\n", seq_dir.c_str());
+  std::printf("frames           %d (with an estimate: %d, succeeded: %d)\n", s.frames, s.present, s.succeeded);
+  std::printf("success rate     %.1f %% (within 50 mm and 5 deg)\n", 100.0 * s.success_rate);
+  std::printf("losses           %d\n", s.losses);
+  if (ignored > 0) std::printf("ignored          %d estimates for frames without ground truth\n", ignored);
+  std::printf("%-16s %10s %10s %10s\n", "", "mean", "median", "p95");
+  const auto row = [](const char* name, const ErrorStats& e) {
+    std::printf("%-16s %10.3f %10.3f %10.3f\n", name, e.mean, e.median, e.p95);
+  };
+  row("rotation_deg", s.rotation_deg);
+  row("translation_mm", s.translation_mm);
+  row("reprojection_px", s.reprojection_px);
+}
+
+const CommandRegistration registration{
+    "score", "Score a tracker's poses against a sequence's ground truth (5 cm / 5 deg success, errors, losses)",
+    [](CLI::App& app) {
+      auto seq_dir = std::make_shared<std::string>();
+      auto poses_path = std::make_shared<std::string>();
+      auto json = std::make_shared<bool>(false);
+      auto axis_text = std::make_shared<std::string>();
+      auto per_frame = std::make_shared<std::string>();
+      app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
+      app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
+      app.add_flag("--json", *json,
+                   "Print one JSON object: frames, present, succeeded, success_rate, losses, "
+                   "rotation_deg/translation_mm/reprojection_px {mean, median, p95}");
+      app.add_option("--sym-axis", *axis_text,
+                     "X,Y,Z: the object is symmetric about this axis through its origin (object frame); "
+                     "the unobservable turn about it is removed before scoring");
+      app.add_option("--per-frame", *per_frame,
+                     "Write frame,present,success,rotation_deg,translation_mm,reprojection_px to this CSV");
+      return [=]() -> int {
+        std::optional<Eigen::Vector3d> axis;
+        if (!axis_text->empty()) {
+          auto parsed = parse_axis(*axis_text);
+          if (!parsed) return fail("score", parsed.error());
+          axis = *parsed;
+        }
+        auto seq = vision::Sequence::open(*seq_dir);
+        if (!seq) return fail("score", seq.error());
+        if (!seq->has_ground_truth())
+          return fail("score", *seq_dir + " has no gt.csv (no ground truth to score against)");
+        auto estimates = vision::read_pose_csv(*poses_path);
+        if (!estimates) return fail("score", estimates.error());
+
+        const ScoreSummary summary =
+            vision::score_poses(seq->ground_truth(), *estimates, seq->camera(), seq->model(), axis);
+        std::set<int> truth_frames;
+        for (const auto& g : seq->ground_truth()) truth_frames.insert(g.frame);
+        int ignored = 0;
+        for (const auto& e : *estimates) ignored += truth_frames.count(e.frame) == 0;
+
+        if (!per_frame->empty()) {
+          if (auto written = write_per_frame(*per_frame, summary); !written) return fail("score", written.error());
+        }
+        if (*json) {
+          const nlohmann::json j{{"frames", summary.frames},
+                                 {"present", summary.present},
+                                 {"succeeded", summary.succeeded},
+                                 {"success_rate", summary.success_rate},
+                                 {"losses", summary.losses},
+                                 {"ignored", ignored},
+                                 {"rotation_deg", stats_json(summary.rotation_deg)},
+                                 {"translation_mm", stats_json(summary.translation_mm)},
+                                 {"reprojection_px", stats_json(summary.reprojection_px)}};
+          std::cout << j.dump() << std::endl;
+        } else {
+          print_human(*seq_dir, summary, ignored);
+        }
+        return 0;
+      };
+    }};
+
+}  // namespace
+}  // namespace epichead::tools

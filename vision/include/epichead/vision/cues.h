@@ -1,0 +1,75 @@
+#pragma once
+// Cues (EPIC step 3b): intensity, colour (chromaticity r, g) and texture. The cue value of an
+// interval between two edgels is the mode of the cue's histogram over the interval (the paper's
+// choice: robust to the blurred pixels at the interval ends and cheaper than a median), refined
+// to the mean of the samples in the modal bin. An interval is compared with a reference mean and
+// deviation by C = exp(-(mu - c)^2 / (2 sigma^2)) (Eq. 1 read with sigma^2: dimensionless).
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "epichead/vision/edgels.h"
+#include "epichead/vision/line_window.h"
+
+namespace epichead::vision {
+
+// The cue value of one interval, per CueChannel; valid = false for an empty interval.
+struct IntervalCues {
+  std::array<float, kCueChannels> value{};
+  bool valid = false;
+};
+
+// Reference of one side of one feature: mean and deviation per CueChannel.
+struct CueReference {
+  std::array<float, kCueChannels> mu{};
+  std::array<float, kCueChannels> sigma{};
+};
+
+struct CueOptions {
+  // Histogram bins: intensity over 0..256, chromaticity per axis over 0..256 (a 2-D histogram),
+  // texture over 0..texture_range (larger values fall in the last bin).
+  int intensity_bins = 32;
+  int chroma_bins = 16;
+  int texture_bins = 32;
+  float texture_range = 64.0f;
+  // Pixels either side of an edgel left out of both intervals: the blurred transition belongs
+  // to neither surface.
+  int edge_margin_px = 1;
+  // Floors on sigma per channel (intensity, chroma r, chroma g, texture), so that a perfectly
+  // uniform surface does not make C a delta: about the camera noise plus half a bin.
+  std::array<float, kCueChannels> sigma_floor{4.0f, 4.0f, 4.0f, 2.0f};
+};
+
+// Number of cues the likelihood sums over: 3 with colour, 2 without.
+inline int cue_count(bool colour) { return colour ? 3 : 2; }
+
+// Sum over cues of C_i (intensity, colour as one 2-D cue, texture), in [0, cue_count].
+// An invalid interval contributes 0: no evidence for the edgel.
+float cue_agreement(const IntervalCues& cues, const CueReference& ref, bool colour);
+
+// Per-window histogram machinery: bins every pixel once, then takes interval modes.
+class CueHistograms {
+ public:
+  explicit CueHistograms(const CueOptions& options = {});
+  const CueOptions& options() const { return options_; }
+  // Bins all pixels of `window` (call once per window before interval()).
+  void prepare(const LineWindow& window);
+  // Mode of each cue over columns [col_begin, col_end) of `row`; invalid when empty.
+  IntervalCues interval(const LineWindow& window, int row, int col_begin, int col_end);
+  // The intervals of every row split at the edgels (edge_margin_px left out around each):
+  // row r with m edgels gives m + 1 intervals; edgel e's left interval is e + r, so
+  // `edgels.edgels[e].left_interval` is set here. `out` has capacity reserved by the caller.
+  // Only intervals on the used side(s) of the edgels are computed (the object side: the other
+  // side's weight is 0); the rest are left invalid.
+  void intervals(const LineWindow& window, EdgelSet& edgels, std::vector<IntervalCues>& out,
+                 bool left_of_edgels = true, bool right_of_edgels = true);
+
+ private:
+  CueOptions options_;
+  int capacity_ = 0;
+  std::vector<std::uint16_t> bin_i_, bin_t_, bin_c_;  // per pixel (bin_c_: 2-D chroma bin)
+  // Histogram counts, all zero between calls (cleared by revisiting the interval's pixels).
+  std::vector<std::uint16_t> count_i_, count_c_, count_t_;
+};
+
+}  // namespace epichead::vision

@@ -1,0 +1,244 @@
+#include "epichead/vision/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include <Eigen/LU>
+#include <opencv2/core.hpp>
+
+namespace epichead::vision {
+namespace {
+
+using Error = std::unexpected<std::string>;
+
+std::string shape(const cv::Mat& m) { return std::to_string(m.rows) + "x" + std::to_string(m.cols); }
+
+// Reads a positive integer size field (image_width, image_height).
+std::expected<int, std::string> read_size(const cv::FileStorage& fs, const std::string& path, const char* field) {
+  const cv::FileNode node = fs[field];
+  if (node.empty() || node.isNone()) return Error(path + ": missing field '" + field + "'");
+  if (!node.isInt() && !node.isReal()) return Error(path + ": " + field + " must be a number");
+  const double value = node.real();
+  if (!std::isfinite(value) || value != std::floor(value))
+    return Error(path + ": " + field + " must be a whole number of pixels");
+  if (value <= 0 || value > 1e6) return Error(path + ": " + field + " must be positive (and sane), got " + std::to_string(value));
+  return static_cast<int>(value);
+}
+
+// Reads an opencv-matrix field as CV_64F.
+std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const std::string& path, const char* field) {
+  const cv::FileNode node = fs[field];
+  if (node.empty() || node.isNone()) return Error(path + ": missing field '" + field + "'");
+  if (!node.isMap()) return Error(path + ": " + field + " must be an opencv-matrix (rows, cols, dt, data)");
+  cv::Mat m;
+  try {
+    node >> m;
+  } catch (const cv::Exception& e) {
+    return Error(path + ": " + field + " is not a valid opencv-matrix: " + e.err);
+  }
+  if (m.empty() && node["rows"].empty()) return Error(path + ": " + field + " is not a valid opencv-matrix (no rows)");
+  if (m.channels() != 1) return Error(path + ": " + field + " must have one channel");
+  if (!m.empty()) m.convertTo(m, CV_64F);
+  for (int r = 0; r < m.rows; ++r)
+    for (int c = 0; c < m.cols; ++c)
+      if (!std::isfinite(m.at<double>(r, c)))
+        return Error(path + ": " + field + " has a non-finite value at (" + std::to_string(r) + "," + std::to_string(c) + ")");
+  return m;
+}
+
+std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path) {
+  auto width = read_size(fs, path, "image_width");
+  if (!width) return Error(width.error());
+  auto height = read_size(fs, path, "image_height");
+  if (!height) return Error(height.error());
+
+  auto k = read_matrix(fs, path, "camera_matrix");
+  if (!k) return Error(k.error());
+  if (k->rows != 3 || k->cols != 3) return Error(path + ": camera_matrix must be 3x3, got " + shape(*k));
+  const cv::Mat& K = *k;
+  Intrinsics in{K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2)};
+  if (!(in.fx_px > 0)) return Error(path + ": fx must be positive");
+  if (!(in.fy_px > 0)) return Error(path + ": fy must be positive");
+  // The model has no skew and a normalised last row: anything else is a different camera model.
+  if (std::abs(K.at<double>(0, 1)) > 1e-9 * in.fx_px)
+    return Error(path + ": camera_matrix has skew (element 0,1 = " + std::to_string(K.at<double>(0, 1)) + "), which is not modelled");
+  if (K.at<double>(1, 0) != 0 || K.at<double>(2, 0) != 0 || K.at<double>(2, 1) != 0 || K.at<double>(2, 2) != 1)
+    return Error(path + ": camera_matrix must have the form [fx 0 cx; 0 fy cy; 0 0 1]");
+
+  auto d = read_matrix(fs, path, "distortion_coefficients");
+  if (!d) return Error(d.error());
+  Distortion dist{};
+  if (!d->empty()) {
+    if (d->rows != 1 && d->cols != 1)
+      return Error(path + ": distortion_coefficients must be a row or column vector, got " + shape(*d));
+    const int n = static_cast<int>(d->total());
+    if (n == 8 || n == 12 || n == 14)
+      return Error(path + ": distortion_coefficients has " + std::to_string(n) +
+                   " values (rational / thin-prism / tilted model); only k1 k2 p1 p2 k3 (4 or 5 values) is supported");
+    if (n != 4 && n != 5)
+      return Error(path + ": distortion_coefficients must have 0, 4 or 5 values, got " + std::to_string(n));
+    for (int i = 0; i < n; ++i) dist[static_cast<std::size_t>(i)] = d->at<double>(i);
+  }
+  return Camera(*width, *height, in, dist);
+}
+
+}  // namespace
+
+Camera::Camera(int width_px, int height_px, const Intrinsics& k, const Distortion& distortion)
+    : width_px_(width_px), height_px_(height_px), k_(k), dist_(distortion) {
+  if (width_px <= 0 || height_px <= 0) throw std::invalid_argument("Camera: image size must be positive");
+  if (!(k.fx_px > 0) || !(k.fy_px > 0) || !std::isfinite(k.fx_px) || !std::isfinite(k.fy_px))
+    throw std::invalid_argument("Camera: focal lengths must be positive and finite");
+  if (!std::isfinite(k.cx_px) || !std::isfinite(k.cy_px)) throw std::invalid_argument("Camera: principal point must be finite");
+  for (double c : dist_)
+    if (!std::isfinite(c)) throw std::invalid_argument("Camera: distortion coefficients must be finite");
+  has_distortion_ = std::any_of(dist_.begin(), dist_.end(), [](double c) { return c != 0; });
+}
+
+std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
+  std::ifstream probe(yaml_path, std::ios::binary);
+  std::error_code ec;
+  if (!probe || !std::filesystem::is_regular_file(yaml_path, ec)) return Error(yaml_path + ": cannot open (no such file)");
+  std::string start(9, '\0');
+  probe.read(start.data(), static_cast<std::streamsize>(start.size()));
+  start.resize(static_cast<std::size_t>(probe.gcount()));
+  if (start.empty()) return Error(yaml_path + ": empty file (expected OpenCV FileStorage YAML)");
+  // OpenCV's YAML reader insists on the directive line; saying so beats its "Input file is invalid".
+  const std::string hint = start.starts_with("%YAML") ? "" : "; it must start with %YAML:1.0";
+  try {
+    cv::FileStorage fs(yaml_path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    if (!fs.isOpened()) return Error(yaml_path + ": cannot open as OpenCV FileStorage YAML" + hint);
+    if (!fs.root().isMap()) return Error(yaml_path + ": not an OpenCV FileStorage YAML mapping");
+    return load_from(fs, yaml_path);
+  } catch (const cv::Exception& e) {
+    // OpenCV's parser throws on text that is not YAML.
+    return Error(yaml_path + ": not OpenCV FileStorage YAML (" + e.err + hint + ")");
+  }
+}
+
+std::expected<void, std::string> Camera::save(const std::string& yaml_path) const {
+  // Checked here so that the message is ours (OpenCV would also log its own).
+  std::error_code ec;
+  const std::filesystem::path parent = std::filesystem::path(yaml_path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    return Error(yaml_path + ": cannot open for writing (no directory " + parent.string() + ")");
+  try {
+    cv::FileStorage fs(yaml_path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
+    if (!fs.isOpened()) return Error(yaml_path + ": cannot open for writing");
+    fs << "image_width" << width_px_ << "image_height" << height_px_;
+    const cv::Mat K = (cv::Mat_<double>(3, 3) << k_.fx_px, 0, k_.cx_px, 0, k_.fy_px, k_.cy_px, 0, 0, 1);
+    cv::Mat d(1, 5, CV_64F);
+    for (int i = 0; i < 5; ++i) d.at<double>(i) = dist_[static_cast<std::size_t>(i)];
+    fs << "camera_matrix" << K << "distortion_coefficients" << d;
+    fs.release();
+  } catch (const cv::Exception& e) {
+    return Error(yaml_path + ": cannot write (" + e.err + ")");
+  }
+  return {};
+}
+
+Eigen::Matrix3d Camera::K() const {
+  Eigen::Matrix3d K;
+  K << k_.fx_px, 0, k_.cx_px, 0, k_.fy_px, k_.cy_px, 0, 0, 1;
+  return K;
+}
+
+Eigen::Vector2d Camera::normalized_to_pixel(const Eigen::Vector2d& xn) const {
+  const double x = xn.x(), y = xn.y();
+  if (!has_distortion_) return {k_.fx_px * x + k_.cx_px, k_.fy_px * y + k_.cy_px};
+  const auto [k1, k2, p1, p2, k3] = dist_;
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  return {k_.fx_px * xd + k_.cx_px, k_.fy_px * yd + k_.cy_px};
+}
+
+Eigen::Matrix2d Camera::normalized_to_pixel_jacobian(const Eigen::Vector2d& xn) const {
+  Eigen::Matrix2d J = Eigen::Matrix2d::Identity();
+  if (has_distortion_) {
+    const double x = xn.x(), y = xn.y();
+    const auto [k1, k2, p1, p2, k3] = dist_;
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
+    const double dradial_dx = 2 * x * dradial_dr2, dradial_dy = 2 * y * dradial_dr2;
+    J(0, 0) = radial + x * dradial_dx + 2 * p1 * y + 6 * p2 * x;
+    J(0, 1) = x * dradial_dy + 2 * p1 * x + 2 * p2 * y;
+    J(1, 0) = y * dradial_dx + 2 * p1 * x + 2 * p2 * y;
+    J(1, 1) = radial + y * dradial_dy + 6 * p1 * y + 2 * p2 * x;
+  }
+  J.row(0) *= k_.fx_px;
+  J.row(1) *= k_.fy_px;
+  return J;
+}
+
+Eigen::Vector2d Camera::pixel_to_normalized(const Eigen::Vector2d& px) const {
+  // Distorted normalised coordinates.
+  const Eigen::Vector2d xd((px.x() - k_.cx_px) / k_.fx_px, (px.y() - k_.cy_px) / k_.fy_px);
+  if (!has_distortion_ || !xd.allFinite()) return xd;
+  // Damped Newton on distort(x) = xd, starting at xd. cv::undistortPoints' fixed-point
+  // iteration converges slowly (or not at all) under strong distortion; Newton with a
+  // residual-decrease test converges quadratically inside the image and, where the model
+  // folds over (far outside the image, no preimage), stops at the closest point it reached.
+  const Eigen::Vector2d f(k_.fx_px, k_.fy_px);
+  auto residual = [&](const Eigen::Vector2d& x) -> Eigen::Vector2d {
+    return (normalized_to_pixel(x) - px).cwiseQuotient(f);
+  };
+  Eigen::Vector2d x = xd;
+  Eigen::Vector2d r = residual(x);
+  double err = r.squaredNorm();
+  constexpr int kMaxIterations = 50;
+  constexpr double kTolerance = 1e-12;  // in normalised units
+  for (int it = 0; it < kMaxIterations && std::sqrt(err) > kTolerance; ++it) {
+    Eigen::Matrix2d J = normalized_to_pixel_jacobian(x);
+    J.row(0) /= k_.fx_px;
+    J.row(1) /= k_.fy_px;
+    Eigen::Vector2d step;
+    const double det = J.determinant();
+    if (std::abs(det) > 1e-12) {
+      step = -J.inverse() * r;
+    } else {
+      step = -J.transpose() * r;  // gradient direction at a fold of the model
+    }
+    if (!step.allFinite()) break;
+    bool improved = false;
+    for (int halvings = 0; halvings < 40; ++halvings) {
+      const Eigen::Vector2d candidate = x + step;
+      const Eigen::Vector2d rc = residual(candidate);
+      const double ec = rc.squaredNorm();
+      if (std::isfinite(ec) && ec < err) {
+        x = candidate;
+        r = rc;
+        err = ec;
+        improved = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!improved) break;  // a local minimum of the residual: no better preimage nearby
+  }
+  return x;
+}
+
+Eigen::Vector2d Camera::project(const Eigen::Vector3d& p_cam) const {
+  if (!(p_cam.z() > 0)) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return normalized_to_pixel(Eigen::Vector2d(p_cam.x() / p_cam.z(), p_cam.y() / p_cam.z()));
+}
+
+Eigen::Vector3d Camera::unproject(const Eigen::Vector2d& px) const {
+  const Eigen::Vector2d xn = pixel_to_normalized(px);
+  return {xn.x(), xn.y(), 1.0};
+}
+
+bool Camera::in_image(const Eigen::Vector2d& px, double margin_px) const {
+  // Pixel centres are at integer coordinates (OpenCV): the image spans [0, width-1] x [0, height-1].
+  return px.x() >= margin_px && px.y() >= margin_px && px.x() <= width_px_ - 1 - margin_px &&
+         px.y() <= height_px_ - 1 - margin_px;
+}
+
+}  // namespace epichead::vision

@@ -1,0 +1,705 @@
+// ViSP's CAO model format (V1): reader with load() includes, and writer.
+//
+// ViSP reads a CAO file as a stream of tokens (with `#` comment lines), so tokens may be spread
+// over lines freely; we do the same but keep the line of every token for messages. Sections, in
+// order: points, lines, faces from lines, faces from points, cylinders (`p1 p2 radius`), circles
+// (`radius centre p1 p2`). The last two may be missing in old files. `load("f.cao")` lines come
+// right after the version, each file's indices refer to its own points, and its points are
+// appended after those already loaded (ViSP's behaviour).
+#include "epichead/vision/cao_model.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+
+#include <Eigen/Geometry>
+
+#include "cao_build.h"
+
+namespace epichead::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr long long kMaxCount = 10'000'000;  // per section; real models are far below
+constexpr int kMaxLoadDepth = 16;
+constexpr int kMaxLoadedFiles = 1000;
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
+
+struct Token {
+  std::string_view text;  // empty at the end of the input
+  int line = 0;
+  bool end() const { return text.empty(); }
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+
+// Splits CAO text into whitespace-separated tokens, dropping `#` and `//` comments (ViSP's
+// documentation writes `//` after values), counting lines for messages.
+class Lexer {
+ public:
+  explicit Lexer(std::string_view text) : text_(text) {
+    if (text_.starts_with("\xEF\xBB\xBF")) pos_ = 3;  // UTF-8 byte order mark
+  }
+
+  Token next() {
+    skip_blank();
+    if (pos_ >= text_.size()) {
+      // The end is on the last line, not on the empty one after a final line break.
+      const bool final_break = !text_.empty() && text_.back() == '\n';
+      return {{}, std::max(1, line_ - (final_break ? 1 : 0))};
+    }
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !is_space(text_[pos_]) && text_[pos_] != '#') {
+      if (text_[pos_] == '"' && pos_ > start && text_[pos_ - 1] == '=') {
+        // name="a b": a quoted attribute value may hold blanks, not a line break.
+        const std::size_t close = text_.find_first_of("\"\n", pos_ + 1);
+        pos_ = close == std::string_view::npos ? text_.size() : (text_[close] == '"' ? close + 1 : close);
+        continue;
+      }
+      ++pos_;
+    }
+    return {text_.substr(start, pos_ - start), line_};
+  }
+
+  Token peek() {
+    const std::size_t pos = pos_;
+    const int line = line_;
+    const Token t = next();
+    pos_ = pos;
+    line_ = line;
+    return t;
+  }
+
+  // The rest of the line from the start of `t` (a token from peek()), consumed.
+  std::string_view take_line(const Token& t) {
+    const auto start = static_cast<std::size_t>(t.text.data() - text_.data());
+    std::size_t end = text_.find('\n', start);
+    if (end == std::string_view::npos) end = text_.size();
+    pos_ = end;
+    line_ = t.line;
+    return text_.substr(start, end - start);
+  }
+
+  int line() const { return line_; }
+
+ private:
+  void skip_blank() {
+    while (pos_ < text_.size()) {
+      const char c = text_[pos_];
+      if (is_space(c)) {
+        line_ += c == '\n';
+        ++pos_;
+      } else if (c == '#' || (c == '/' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '/')) {
+        const std::size_t eol = text_.find('\n', pos_);
+        pos_ = eol == std::string_view::npos ? text_.size() : eol;
+      } else {
+        break;
+      }
+    }
+  }
+
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+};
+
+// A token as it appears in a message: quoted, shortened, control bytes escaped.
+std::string shown(const Token& t) {
+  if (t.end()) return "end of file";
+  std::string out = "'";
+  const std::size_t n = std::min<std::size_t>(t.text.size(), 40);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(t.text[i]);
+    if (c < 0x20 || c >= 0x7f) {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  if (t.text.size() > n) out += "...";
+  return out + "'";
+}
+
+bool parse_integer(std::string_view s, long long& value, bool& overflow) {
+  overflow = false;
+  if (s.starts_with('+')) s.remove_prefix(1);
+  if (s.empty()) return false;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (end != s.data() + s.size()) return false;
+  if (ec == std::errc::result_out_of_range) overflow = true;
+  return ec == std::errc{} || overflow;
+}
+
+// A finite decimal number taking the whole of `s`.
+bool parse_number(std::string_view s, double& value) {
+  if (s.starts_with('+')) s.remove_prefix(1);
+  if (s.empty()) return false;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  return ec == std::errc{} && end == s.data() + s.size() && std::isfinite(value);
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::expected<std::string, std::string> read_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return std::unexpected(path.string() + ": cannot open (no such file)");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec || size > kMaxFileBytes) return std::unexpected(path.string() + ": cannot read (unreadable or too large)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::unexpected(path.string() + ": cannot open");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) return std::unexpected(path.string() + ": read error");
+  return std::move(buffer).str();
+}
+
+// Files being loaded, outermost first: canonical path (to find cycles) and name for messages.
+struct LoadChain {
+  std::vector<std::string> ids;
+  std::vector<std::string> names;
+};
+
+struct Accumulator {
+  RawModel raw;
+  detail::RawSources where;
+  int files = 0;
+};
+
+// Reads one CAO file's text into the accumulator, recursing into load()s.
+class Parser {
+ public:
+  Parser(std::string_view text, std::string name, fs::path dir, const Eigen::Isometry3d& model_T_file,
+         LoadChain& chain, Accumulator& acc)
+      : lex_(text), name_(std::move(name)), dir_(std::move(dir)), model_T_file_(model_T_file), chain_(chain),
+        acc_(acc) {}
+
+  std::expected<void, std::string> run() {
+    if (auto ok = read_version(); !ok) return ok;
+    if (auto ok = read_loads(); !ok) return ok;
+    if (auto ok = read_points(); !ok) return ok;
+    if (auto ok = read_lines(); !ok) return ok;
+    if (auto ok = read_faces_from_lines(); !ok) return ok;
+    if (auto ok = read_faces_from_points(); !ok) return ok;
+    if (value_token_peek().end()) return {};  // files older than cylinders end here
+    if (auto ok = read_cylinders(); !ok) return ok;
+    if (value_token_peek().end()) return {};  // ... or before circles
+    if (auto ok = read_circles(); !ok) return ok;
+    if (const Token t = value_token(); !t.end()) return expected(t, "end of file");
+    return {};
+  }
+
+ private:
+  using Fail = std::unexpected<std::string>;
+
+  std::string at(int line) const { return name_ + ":" + std::to_string(line); }
+  std::string at(const Token& t) const { return at(t.line); }
+  Fail fail(const Token& t, const std::string& what) const { return Fail(at(t) + ": " + what); }
+  Fail expected(const Token& t, const std::string& what) const {
+    return fail(t, "expected " + what + ", got " + shown(t));
+  }
+
+  // The next token that is not a `key=value` attribute (ViSP's name=..., useLod=...; others
+  // are skipped too, so newer files still load).
+  Token value_token() {
+    for (;;) {
+      const Token t = lex_.next();
+      if (t.end() || t.text.find('=') == std::string_view::npos) return t;
+    }
+  }
+  Token value_token_peek() {
+    for (;;) {
+      const Token t = lex_.peek();
+      if (t.end() || t.text.find('=') == std::string_view::npos) return t;
+      lex_.next();
+    }
+  }
+
+  // `what` names the expected value; it is called only to write a message, so that reading
+  // a large file builds no strings.
+  template <class What>
+  std::expected<long long, std::string> read_integer(const What& what, Token& t) {
+    t = value_token();
+    long long value = 0;
+    bool overflow = false;
+    if (!parse_integer(t.text, value, overflow)) return expected(t, what());
+    if (overflow) return fail(t, what() + " " + shown(t) + " out of range");
+    return value;
+  }
+
+  std::expected<long long, std::string> read_count(const std::string& what) {
+    Token t;
+    auto n = read_integer([&] { return what; }, t);
+    if (n && (*n < 0 || *n > kMaxCount)) {
+      return fail(t, what + " " + std::to_string(*n) + " out of range (0 to " + std::to_string(kMaxCount) + ")");
+    }
+    return n;
+  }
+
+  // An index into a list of `count` items of this file (ViSP: indices are local to the file).
+  std::expected<int, std::string> read_index(const char* kind, std::size_t count, Token& t) {
+    auto i = read_integer([kind] { return std::string(kind) + " index"; }, t);
+    if (!i) return std::unexpected(i.error());
+    if (*i < 0 || static_cast<unsigned long long>(*i) >= count) {
+      return fail(t, std::string(kind) + " index " + std::to_string(*i) + " out of range (" +
+                         std::to_string(count) + " " + kind + "s)");
+    }
+    return static_cast<int>(*i);
+  }
+
+  std::expected<int, std::string> read_point(Token& t) {
+    auto i = read_index("point", points_, t);
+    if (!i) return i;
+    return *i + point_offset_;
+  }
+
+  template <class What>
+  std::expected<double, std::string> read_number(const What& what, Token& t) {
+    t = value_token();
+    double value = 0;
+    if (!parse_number(t.text, value)) return expected(t, what() + " (a finite number)");
+    return value;
+  }
+
+  std::expected<double, std::string> read_radius() {
+    Token t;
+    auto r = read_number([] { return std::string("radius"); }, t);
+    if (r && !(*r > 0)) return fail(t, "radius must be > 0, got " + shown(t));
+    return r;
+  }
+
+  std::expected<void, std::string> read_version() {
+    Token t = value_token();
+    std::string_view v = t.text;
+    if (v == "V" || v == "v") {  // ViSP reads 'V' and then a number
+      t = value_token();
+      v = t.text;
+    } else if (v.starts_with('V') || v.starts_with('v')) {
+      v.remove_prefix(1);
+    } else {
+      return expected(t, "version 'V1'");
+    }
+    // V2 adds two image coordinates to every point, which we skip.
+    if (v == "1") version_ = 1;
+    else if (v == "2") version_ = 2;
+    else return expected(t, "version 'V1'");
+    return {};
+  }
+
+  std::expected<void, std::string> read_loads() {
+    for (Token t = lex_.peek(); t.text.starts_with("load"); t = lex_.peek()) {
+      const std::string_view line = lex_.take_line(t);
+      if (auto ok = load(line, t); !ok) return ok;
+    }
+    return {};
+  }
+
+  // load("file.cao"[, t=[x;y;z]][, tu=[rx;ry;rz]]): the file's points map into this one by
+  // (tu, t), tu an axis-angle vector, angles in rad unless suffixed "deg" (ViSP's syntax).
+  std::expected<void, std::string> load(std::string_view line, const Token& t) {
+    std::string_view s = trim(line.substr(4));
+    if (!s.starts_with('(')) return fail(t, "expected load(\"file.cao\")");
+    s.remove_prefix(1);
+    s = trim(s);
+    if (!s.starts_with('"')) return fail(t, "expected a quoted file name in load()");
+    const std::size_t quote = s.find('"', 1);
+    if (quote == std::string_view::npos) return fail(t, "missing closing '\"' in load()");
+    const std::string file(s.substr(1, quote - 1));
+    s.remove_prefix(quote + 1);
+    const std::size_t close = s.find(')');
+    if (close == std::string_view::npos) return fail(t, "missing ')' closing load()");
+    std::string_view params = s.substr(0, close);
+    Eigen::Vector3d trans = Eigen::Vector3d::Zero(), tu = Eigen::Vector3d::Zero();
+    while (!trim(params).empty()) {
+      params = trim(params);
+      if (!params.starts_with(',')) return fail(t, "expected ',' between load() parameters");
+      params.remove_prefix(1);
+      const std::size_t comma = params.find(',');  // vector values are split by ';'
+      const std::string_view param = trim(params.substr(0, comma));
+      params = comma == std::string_view::npos ? std::string_view{} : params.substr(comma);
+      Eigen::Vector3d* target = param.starts_with("t=") ? &trans : param.starts_with("tu=") ? &tu : nullptr;
+      if (!target) continue;  // unknown key=value: skipped
+      if (!parse_vector(param.substr(param.find('=') + 1), target == &tu, *target)) {
+        return fail(t, "expected t=[x;y;z] or tu=[rx;ry;rz] in load(), got '" +
+                           std::string(param.substr(0, 60)) + "'");
+      }
+    }
+    Eigen::Isometry3d file_T_child = Eigen::Isometry3d::Identity();
+    const double angle = tu.norm();
+    if (angle > 0) file_T_child.linear() = Eigen::AngleAxisd(angle, tu / angle).toRotationMatrix();
+    file_T_child.translation() = trans;
+
+    const fs::path given(file);
+    const fs::path path = (given.is_absolute() ? given : dir_ / given).lexically_normal();
+    std::error_code ec;
+    const std::string id = fs::weakly_canonical(path, ec).string();
+    for (std::size_t i = 0; i < chain_.ids.size(); ++i) {
+      if (chain_.ids[i] != id) continue;
+      std::string cycle;
+      for (std::size_t k = i; k < chain_.names.size(); ++k) cycle += chain_.names[k] + " -> ";
+      return fail(t, "load() cycle: " + cycle + path.string());
+    }
+    if (static_cast<int>(chain_.ids.size()) >= kMaxLoadDepth) {
+      return fail(t, "load() nested deeper than " + std::to_string(kMaxLoadDepth) + " files");
+    }
+    if (++acc_.files > kMaxLoadedFiles) {
+      return fail(t, "more than " + std::to_string(kMaxLoadedFiles) + " files loaded");
+    }
+    auto text = read_file(path);
+    if (!text) return fail(t, "load(): " + text.error());
+    chain_.ids.push_back(id);
+    chain_.names.push_back(path.string());
+    Parser child(*text, path.string(), path.parent_path(), model_T_file_ * file_T_child, chain_, acc_);
+    auto ok = child.run();
+    chain_.ids.pop_back();
+    chain_.names.pop_back();
+    return ok;
+  }
+
+  // "[a;b;c]", each value optionally suffixed "rad" or (for angles) "deg".
+  static bool parse_vector(std::string_view s, bool angles, Eigen::Vector3d& out) {
+    s = trim(s);
+    if (!s.starts_with('[') || !s.ends_with(']')) return false;
+    s = s.substr(1, s.size() - 2);
+    for (int i = 0; i < 3; ++i) {
+      const std::size_t semi = s.find(';');
+      if ((i < 2) != (semi != std::string_view::npos)) return false;
+      std::string_view v = trim(s.substr(0, semi));
+      s = semi == std::string_view::npos ? std::string_view{} : s.substr(semi + 1);
+      double scale = 1;
+      if (angles && v.ends_with("deg")) {
+        v.remove_suffix(3);
+        scale = std::numbers::pi / 180;
+      } else if (angles && v.ends_with("rad")) {
+        v.remove_suffix(3);
+      }
+      if (!parse_number(trim(v), out[i])) return false;
+      out[i] *= scale;
+    }
+    return true;
+  }
+
+  std::expected<void, std::string> read_points() {
+    auto n = read_count("number of points");
+    if (!n) return std::unexpected(n.error());
+    point_offset_ = static_cast<int>(acc_.raw.vertices.size());
+    if (static_cast<long long>(point_offset_) + *n > kMaxCount) {
+      return Fail(at(lex_.line()) + ": more than " + std::to_string(kMaxCount) + " points in all");
+    }
+    for (long long k = 0; k < *n; ++k) {
+      Eigen::Vector3d p;
+      Token t;
+      for (int c = 0; c < 3; ++c) {
+        const auto what = [&] { return std::string("coordinate ") + "XYZ"[c] + " of point " + std::to_string(k); };
+        auto v = read_number(what, t);
+        if (!v) return std::unexpected(v.error());
+        p[c] = *v;
+      }
+      for (int c = 0; c < (version_ == 2 ? 2 : 0); ++c) {
+        if (auto v = read_integer([&] { return "image coordinate of point " + std::to_string(k); }, t); !v) {
+          return std::unexpected(v.error());
+        }
+      }
+      acc_.raw.vertices.push_back(model_T_file_ * p);
+    }
+    points_ = static_cast<std::size_t>(*n);
+    return {};
+  }
+
+  std::expected<void, std::string> read_lines() {
+    auto n = read_count("number of lines");
+    if (!n) return std::unexpected(n.error());
+    for (long long k = 0; k < *n; ++k) {
+      Token ta, tb;
+      auto a = read_point(ta);
+      if (!a) return std::unexpected(a.error());
+      auto b = read_point(tb);
+      if (!b) return std::unexpected(b.error());
+      if (*a == *b || acc_.raw.vertices[*a] == acc_.raw.vertices[*b]) {
+        return fail(tb, "line has equal end points (" + std::string(ta.text) + " " + std::string(tb.text) + ")");
+      }
+      lines_.push_back({*a, *b});
+      acc_.raw.free_lines.push_back({*a, *b});  // merged into face edges they lie on
+      acc_.where.lines.push_back(at(ta));
+    }
+    return {};
+  }
+
+  std::expected<long long, std::string> read_face_size(const char* of, Token& t) {
+    auto n = read_integer([of] { return std::string("number of ") + of + " of a face"; }, t);
+    if (!n) return n;
+    if (*n < 3 || *n > kMaxCount) {
+      return fail(t, "face has " + std::to_string(*n) + " " + of + ", needs 3 to " + std::to_string(kMaxCount));
+    }
+    return n;
+  }
+
+  // A face given by lines in loop order, each in either direction, chained into a vertex loop.
+  std::expected<void, std::string> read_faces_from_lines() {
+    auto n = read_count("number of faces from lines");
+    if (!n) return std::unexpected(n.error());
+    std::vector<int> ids;
+    std::vector<Token> tokens;
+    for (long long k = 0; k < *n; ++k) {
+      Token head;
+      auto m = read_face_size("lines", head);
+      if (!m) return std::unexpected(m.error());
+      ids.clear();
+      tokens.clear();
+      for (long long i = 0; i < *m; ++i) {
+        Token t;
+        auto l = read_index("line", lines_.size(), t);
+        if (!l) return std::unexpected(l.error());
+        ids.push_back(*l);
+        tokens.push_back(t);
+      }
+      const auto& first = lines_[ids[0]];
+      const auto& second = lines_[ids[1]];
+      // Start at the end of the first line that the second one does not touch.
+      const bool first_reversed = first[0] == second[0] || first[0] == second[1];
+      if (first_reversed && (first[1] == second[0] || first[1] == second[1])) {
+        return fail(tokens[1], "face: line " + std::string(tokens[1].text) + " has the same end points as line " +
+                                   std::string(tokens[0].text));
+      }
+      const int start = first_reversed ? first[1] : first[0];
+      std::vector<int> loop;
+      int at_vertex = start;
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const auto& line = lines_[ids[i]];
+        if (line[0] != at_vertex && line[1] != at_vertex) {
+          return fail(tokens[i], "face: line " + std::string(tokens[i].text) + " does not continue from line " +
+                                     std::string(tokens[i == 0 ? 0 : i - 1].text) + " (lines must form a closed loop)");
+        }
+        loop.push_back(at_vertex);
+        at_vertex = line[0] == at_vertex ? line[1] : line[0];
+      }
+      if (at_vertex != start) {
+        return fail(tokens.back(), "face: its lines do not close (line " + std::string(tokens.back().text) +
+                                       " does not end where line " + std::string(tokens[0].text) + " starts)");
+      }
+      acc_.raw.face_loops.push_back(std::move(loop));
+      acc_.where.faces.push_back(at(head));
+    }
+    return {};
+  }
+
+  std::expected<void, std::string> read_faces_from_points() {
+    auto n = read_count("number of faces from points");
+    if (!n) return std::unexpected(n.error());
+    for (long long k = 0; k < *n; ++k) {
+      Token head;
+      auto m = read_face_size("points", head);
+      if (!m) return std::unexpected(m.error());
+      std::vector<int> loop;
+      for (long long i = 0; i < *m; ++i) {
+        Token t;
+        auto v = read_point(t);
+        if (!v) return std::unexpected(v.error());
+        if (!loop.empty() && loop.back() == *v) {
+          return fail(t, "face has point " + std::string(t.text) + " twice in a row");
+        }
+        loop.push_back(*v);
+      }
+      if (loop.front() == loop.back()) {
+        return fail(head, "face ends on its first point " + std::to_string(loop.front() - point_offset_) +
+                              " (do not repeat it)");
+      }
+      acc_.raw.face_loops.push_back(std::move(loop));
+      acc_.where.faces.push_back(at(head));
+    }
+    return {};
+  }
+
+  std::expected<void, std::string> read_cylinders() {
+    auto n = read_count("number of cylinders");
+    if (!n) return std::unexpected(n.error());
+    for (long long k = 0; k < *n; ++k) {
+      Token ta, tb;
+      auto a = read_point(ta);
+      if (!a) return std::unexpected(a.error());
+      auto b = read_point(tb);
+      if (!b) return std::unexpected(b.error());
+      auto r = read_radius();
+      if (!r) return std::unexpected(r.error());
+      ModelCylinder c;
+      c.axis_a_obj = acc_.raw.vertices[*a];
+      c.axis_b_obj = acc_.raw.vertices[*b];
+      c.radius_m = *r;
+      if (c.axis_a_obj == c.axis_b_obj) return fail(tb, "cylinder axis points are equal");
+      acc_.raw.cylinders.push_back(c);
+      acc_.where.cylinders.push_back(at(ta));
+    }
+    return {};
+  }
+
+  // ViSP: radius, centre point, two more points of the circle's plane. The normal is
+  // (p1 - centre) x (p2 - centre), so the point order sets which side the circle faces.
+  std::expected<void, std::string> read_circles() {
+    auto n = read_count("number of circles");
+    if (!n) return std::unexpected(n.error());
+    for (long long k = 0; k < *n; ++k) {
+      const Token head = value_token_peek();
+      auto r = read_radius();
+      if (!r) return std::unexpected(r.error());
+      Token tc, t1, t2;
+      auto c = read_point(tc);
+      if (!c) return std::unexpected(c.error());
+      auto p1 = read_point(t1);
+      if (!p1) return std::unexpected(p1.error());
+      auto p2 = read_point(t2);
+      if (!p2) return std::unexpected(p2.error());
+      const Eigen::Vector3d& centre = acc_.raw.vertices[*c];
+      const Eigen::Vector3d normal = (acc_.raw.vertices[*p1] - centre).cross(acc_.raw.vertices[*p2] - centre);
+      if (!(normal.norm() > 0) || !normal.allFinite()) {
+        return fail(t2, "circle's plane points are collinear with its centre");
+      }
+      acc_.raw.circles.push_back({centre, normal.normalized(), *r});
+      acc_.where.circles.push_back(at(head));
+    }
+    return {};
+  }
+
+  Lexer lex_;
+  std::string name_;
+  fs::path dir_;
+  Eigen::Isometry3d model_T_file_;
+  LoadChain& chain_;
+  Accumulator& acc_;
+  int version_ = 1;
+  int point_offset_ = 0;   // this file's point 0 in the model
+  std::size_t points_ = 0;  // points in this file
+  std::vector<std::array<int, 2>> lines_;  // this file's lines, model point indices
+};
+
+std::expected<CadModel, std::string> parse_top(const std::string& text, const std::string& name,
+                                               const fs::path& dir, const std::string& id) {
+  LoadChain chain;
+  chain.ids.push_back(id);
+  chain.names.push_back(name);
+  Accumulator acc;
+  Parser parser(text, name, dir, Eigen::Isometry3d::Identity(), chain, acc);
+  if (auto ok = parser.run(); !ok) return std::unexpected(ok.error());
+  return detail::build_model_located(acc.raw, name, &acc.where);
+}
+
+void put_number(std::string& out, double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
+  out.append(buf, ec == std::errc{} ? end : buf);
+}
+
+}  // namespace
+
+std::expected<CadModel, std::string> load_cao(const std::string& path) {
+  auto text = read_file(path);
+  if (!text) return std::unexpected(text.error());
+  std::error_code ec;
+  const fs::path p(path);
+  return parse_top(*text, path, p.parent_path().empty() ? fs::path(".") : p.parent_path(),
+                   fs::weakly_canonical(p, ec).string());
+}
+
+std::expected<CadModel, std::string> parse_cao(const std::string& text, const std::string& name,
+                                               const std::string& base_dir) {
+  std::error_code ec;
+  const fs::path dir = base_dir.empty() ? fs::path(".") : fs::path(base_dir);
+  return parse_top(text, name, dir, fs::weakly_canonical(dir / name, ec).string());
+}
+
+std::string to_cao(const CadModel& model) {
+  // Circles and cylinders refer to points: reuse model vertices at exactly the same place (so
+  // a model read from a file reads back with the same vertices), else append points.
+  std::vector<Eigen::Vector3d> points = model.vertices;
+  std::map<std::array<double, 3>, int> where;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    where.try_emplace({points[i].x(), points[i].y(), points[i].z()}, static_cast<int>(i));
+  }
+  auto point_at = [&](const Eigen::Vector3d& p) {
+    const auto [it, added] = where.try_emplace({p.x(), p.y(), p.z()}, static_cast<int>(points.size()));
+    if (added) points.push_back(p);
+    return it->second;
+  };
+  std::vector<std::array<int, 2>> cylinders;
+  for (const ModelCylinder& c : model.cylinders) cylinders.push_back({point_at(c.axis_a_obj), point_at(c.axis_b_obj)});
+  std::vector<std::array<int, 3>> circles;
+  for (const ModelCircle& c : model.circles) {
+    const int centre = point_at(c.centre_obj);
+    const Eigen::Vector3d n = c.normal_obj.normalized();
+    // Two vertices already in the circle's plane whose cross product gives its normal, if any
+    // (a few candidates only: this is for models read from CAO, where they exist).
+    int p1 = -1, p2 = -1;
+    int tries = 0;
+    for (std::size_t a = 0; a < model.vertices.size() && p1 < 0 && tries < 8; ++a) {
+      const Eigen::Vector3d da = model.vertices[a] - c.centre_obj;
+      if (!(da.norm() > 0) || std::abs(n.dot(da)) > 1e-9 * da.norm()) continue;
+      ++tries;
+      for (std::size_t b = 0; b < model.vertices.size(); ++b) {
+        const Eigen::Vector3d cross = da.cross(model.vertices[b] - c.centre_obj);
+        if (cross.norm() > 0 && n.dot(cross.normalized()) > 1 - 1e-14) {
+          p1 = static_cast<int>(a);
+          p2 = static_cast<int>(b);
+          break;
+        }
+      }
+    }
+    if (p1 < 0) {
+      const Eigen::Vector3d u = n.unitOrthogonal();
+      p1 = point_at(c.centre_obj + c.radius_m * u);
+      p2 = point_at(c.centre_obj + c.radius_m * n.cross(u));
+    }
+    circles.push_back({centre, p1, p2});
+  }
+
+  std::string out = "V1\n# Written by epichead\n# 3D Points\n" + std::to_string(points.size()) + "\n";
+  for (const Eigen::Vector3d& p : points) {
+    put_number(out, p.x());
+    out += ' ';
+    put_number(out, p.y());
+    out += ' ';
+    put_number(out, p.z());
+    out += '\n';
+  }
+  std::string lines;
+  std::size_t line_count = 0;
+  for (const ModelEdge& e : model.edges) {
+    if (e.face_count() != 0 || e.extra_faces != 0) continue;
+    lines += std::to_string(e.v0) + " " + std::to_string(e.v1) + "\n";
+    ++line_count;
+  }
+  out += "# 3D Lines\n" + std::to_string(line_count) + "\n" + lines;
+  out += "# Faces from 3D lines\n0\n# Faces from 3D points\n" + std::to_string(model.faces.size()) + "\n";
+  for (const ModelFace& f : model.faces) {
+    out += std::to_string(f.vertices.size());
+    for (int v : f.vertices) out += " " + std::to_string(v);
+    out += '\n';
+  }
+  out += "# 3D cylinders\n" + std::to_string(cylinders.size()) + "\n";
+  for (std::size_t i = 0; i < cylinders.size(); ++i) {
+    out += std::to_string(cylinders[i][0]) + " " + std::to_string(cylinders[i][1]) + " ";
+    put_number(out, model.cylinders[i].radius_m);
+    out += '\n';
+  }
+  out += "# 3D circles\n" + std::to_string(circles.size()) + "\n";
+  for (std::size_t i = 0; i < circles.size(); ++i) {
+    put_number(out, model.circles[i].radius_m);
+    out += " " + std::to_string(circles[i][0]) + " " + std::to_string(circles[i][1]) + " " +
+           std::to_string(circles[i][2]) + "\n";
+  }
+  return out;
+}
+
+}  // namespace epichead::vision

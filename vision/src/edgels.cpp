@@ -1,0 +1,75 @@
+#include "epichead/vision/edgels.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epichead::vision {
+
+void EdgelSet::reserve(const WindowOptions& options) {
+  const int cols = std::clamp(options.width_px, 8, kMaxWindowWidth), rows = std::max(options.max_rows, 2);
+  // Maxima are at least two columns apart (strict on one side), so cols / 2 per row at most.
+  edgels.reserve(static_cast<std::size_t>(rows) * (cols / 2 + 1));
+  row_begin.reserve(static_cast<std::size_t>(rows) + 1);
+  gradient.resize(static_cast<std::size_t>(rows) * cols);
+}
+
+void find_edgels(const LineWindow& window, const EdgelOptions& options, EdgelSet& out) {
+  const WindowGeometry& g = window.geometry();
+  out.edgels.clear();
+  out.row_begin.clear();
+  out.rows = g.rows;
+  if (g.rows == 0) { out.row_begin.push_back(0); return; }
+  const int cols = g.cols, rows = g.rows;
+  if (out.gradient.size() < static_cast<std::size_t>(rows) * cols) out.gradient.resize(static_cast<std::size_t>(rows) * cols);
+  const float* I = window.plane(CueChannel::Intensity);
+  float* G = out.gradient.data();
+  // Central difference across each row (columns 0 and cols-1 left at 0).
+  for (int r = 0; r < rows; ++r) {
+    const float* in = I + r * cols;
+    float* d = G + r * cols;
+    d[0] = 0;
+    d[cols - 1] = 0;
+    for (int c = 1; c < cols - 1; ++c) d[c] = 0.5f * (in[c + 1] - in[c - 1]);
+  }
+  // [1 2 1] / 4 along the line, in place, top-down: `carry` holds the previous row's
+  // unsmoothed values (row -1 and row `rows` replicate the border rows).
+  const float min_g = options.min_gradient;
+  const float x_centre = 0.5f * static_cast<float>(cols - 1);
+  out.row_begin.resize(static_cast<std::size_t>(rows) + 1);  // within the reserved capacity
+  float carry[kMaxWindowWidth];
+  for (int c = 0; c < cols; ++c) carry[c] = G[c];
+  for (int r = 0; r < rows; ++r) {
+    float* d = G + r * cols;
+    const float* next = G + std::min(r + 1, rows - 1) * cols;  // not yet smoothed
+    for (int c = 0; c < cols; ++c) {
+      const float cur = d[c];
+      const float smoothed = 0.25f * (carry[c] + 2.0f * cur + next[c]);
+      carry[c] = cur;
+      d[c] = smoothed;
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    out.row_begin[r] = static_cast<int>(out.edgels.size());
+    const float* d = G + r * cols;
+    const float s = static_cast<float>(g.s_of_row(r));
+    for (int c = 2; c < cols - 2; ++c) {
+      const float a = std::fabs(d[c]);
+      if (a < min_g) continue;
+      const float l = std::fabs(d[c - 1]), rr = std::fabs(d[c + 1]);
+      if (!(a > l && a >= rr)) continue;
+      const float den = l - 2.0f * a + rr;
+      float off = den < 0 ? 0.5f * (l - rr) / den : 0.0f;
+      off = std::clamp(off, -0.5f, 0.5f);
+      Edgel e;
+      e.col = static_cast<float>(c) + off;
+      e.x_px = e.col - x_centre;
+      e.s_px = s;
+      e.gradient = d[c];
+      e.row = r;
+      out.edgels.push_back(e);
+    }
+  }
+  out.row_begin[rows] = static_cast<int>(out.edgels.size());
+}
+
+}  // namespace epichead::vision

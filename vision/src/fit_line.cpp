@@ -1,0 +1,169 @@
+#include "epichead/vision/fit_line.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epichead::vision {
+
+float WindowLine::distance(float x_px, float s_px) const {
+  return std::fabs(x_px - m * s_px - c) / std::sqrt(1.0f + m * m);
+}
+
+WindowLine fit_line_tls(const float* x_px, const float* s_px, const int* idx, int n) {
+  WindowLine line;
+  if (n < 1) return line;
+  double mx = 0, ms = 0;
+  for (int k = 0; k < n; ++k) { mx += x_px[idx[k]]; ms += s_px[idx[k]]; }
+  mx /= n;
+  ms /= n;
+  double sxx = 0, sss = 0, sxs = 0;
+  for (int k = 0; k < n; ++k) {
+    const double dx = x_px[idx[k]] - mx, ds = s_px[idx[k]] - ms;
+    sxx += dx * dx;
+    sss += ds * ds;
+    sxs += dx * ds;
+  }
+  // Direction of largest spread in (s, x): angle of the principal axis of the 2x2 scatter.
+  // A window line is near-vertical (along s), so cos(theta) is far from 0; guard anyway.
+  const double theta = 0.5 * std::atan2(2.0 * sxs, sss - sxx);
+  const double cs = std::cos(theta), sn = std::sin(theta);
+  const double m = std::fabs(cs) > 1e-6 ? sn / cs : 0.0;
+  line.m = static_cast<float>(m);
+  line.c = static_cast<float>(mx - m * ms);
+  return line;
+}
+
+LineRansac::LineRansac(const RansacOptions& options, int max_points)
+    : options_(options), max_points_(std::max(max_points, 2)) {
+  hypotheses_.reserve(32);
+  candidates_.reserve(32);
+  inliers_.reserve(static_cast<std::size_t>(max_points_) * 32);
+  scratch_.reserve(max_points_);
+  claimed_.assign(max_points_, 0);
+}
+
+int LineRansac::count_support(const WindowLine& line, const float* x, const float* s, int n) const {
+  // |x - m s - c| <= d sqrt(1 + m^2): no division or root per point, and vectorisable.
+  const float tol = options_.inlier_distance_px * std::sqrt(1.0f + line.m * line.m);
+  int support = 0;
+  for (int i = 0; i < n; ++i) support += std::fabs(x[i] - line.m * s[i] - line.c) <= tol;
+  return support;
+}
+
+bool LineRansac::same_line(const WindowLine& a, const WindowLine& b) const {
+  const float d0 = std::fabs(a.x_at(s_begin_) - b.x_at(s_begin_));
+  const float d1 = std::fabs(a.x_at(s_end_) - b.x_at(s_end_));
+  return std::max(d0, d1) < options_.min_separation_px;
+}
+
+int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float s_end) {
+  candidates_.clear();
+  inliers_.clear();
+  hypotheses_.clear();
+  iterations_ = 0;
+  n = std::min(n, max_points_);
+  s_begin_ = s_begin;
+  s_end_ = s_end;
+  const int max_keep = std::max(1, options_.max_candidates);
+  const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
+  if (n < std::max(2, options_.min_support)) return 0;
+  rng_ = 0x9E3779B9u;
+  auto next = [this] {  // xorshift32: deterministic, cheap, good enough for sampling
+    rng_ ^= rng_ << 13; rng_ ^= rng_ >> 17; rng_ ^= rng_ << 5;
+    return rng_;
+  };
+  const double log_fail = std::log(1.0 - std::clamp(options_.probability, 0.0, 0.999999));
+  const float keep = std::clamp(options_.keep_ratio, 0.0f, 1.0f);
+  // Eq. 4 with w = keep * inlier ratio when several candidates are wanted (see header).
+  auto needed = [&](int best) {
+    const double w = (max_keep > 1 ? keep : 1.0f) * static_cast<double>(best) / n;
+    const double miss = 1.0 - w * w;
+    if (miss <= 0) return 1;
+    if (miss >= 1) return options_.max_iterations;
+    return static_cast<int>(std::min<double>(options_.max_iterations, std::ceil(log_fail / std::log(miss))));
+  };
+  int best = 0;
+  int budget = options_.max_iterations;
+  for (; iterations_ < budget; ++iterations_) {
+    const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n));
+    int j = static_cast<int>(next() % static_cast<std::uint32_t>(n - 1));
+    if (j >= i) ++j;
+    const float ds = s[j] - s[i];
+    if (std::fabs(ds) < 1e-3f) continue;  // same row: no near-vertical line through both
+    WindowLine line;
+    line.m = (x[j] - x[i]) / ds;
+    line.c = x[i] - line.m * s[i];
+    const int support = count_support(line, x, s, n);
+    if (support < options_.min_support) continue;
+    if (support > best) {
+      best = support;
+      budget = std::max(1, needed(best));
+    }
+    if (support < keep * best) continue;
+    // Keep the strongest hypothesis per distinct line.
+    bool merged = false;
+    for (auto& h : hypotheses_) {
+      if (same_line(h.line, line)) {
+        if (support > h.support) h = {line, support};
+        merged = true;
+        break;
+      }
+    }
+    if (merged) continue;
+    if (static_cast<int>(hypotheses_.size()) < hyp_capacity) {
+      hypotheses_.push_back({line, support});
+    } else {
+      auto weakest = std::min_element(hypotheses_.begin(), hypotheses_.end(),
+                                      [](const Hypothesis& a, const Hypothesis& b) { return a.support < b.support; });
+      if (weakest->support < support) *weakest = {line, support};
+    }
+  }
+  // Refine each surviving hypothesis: inliers -> TLS -> inliers -> TLS -> final inliers.
+  std::sort(hypotheses_.begin(), hypotheses_.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.support > b.support; });
+  const float tol = options_.inlier_distance_px;
+  std::fill(claimed_.begin(), claimed_.begin() + n, 0);
+  for (const Hypothesis& h : hypotheses_) {
+    if (h.support < keep * best) continue;
+    WindowLine line = h.line;
+    for (int pass = 0; pass < 2; ++pass) {
+      scratch_.clear();
+      for (int k = 0; k < n; ++k) if (line.distance(x[k], s[k]) <= tol) scratch_.push_back(k);
+      if (static_cast<int>(scratch_.size()) < 2) break;
+      line = fit_line_tls(x, s, scratch_.data(), static_cast<int>(scratch_.size()));
+    }
+    scratch_.clear();
+    for (int k = 0; k < n; ++k) if (line.distance(x[k], s[k]) <= tol) scratch_.push_back(k);
+    const int support = static_cast<int>(scratch_.size());
+    if (support < options_.min_support) continue;
+    // Refinement can pull two hypotheses onto one line: keep the first (stronger) one.
+    bool duplicate = false;
+    for (const LineFit& f : candidates_) duplicate = duplicate || same_line(f.line, line);
+    if (duplicate) continue;
+    // A line that lives on points already claimed by stronger candidates is no line of its
+    // own: two close parallel edges make diagonals that cross both within the inlier band.
+    // Hypotheses come strongest first, so this is decided in support order.
+    int exclusive = 0;
+    for (int k : scratch_) exclusive += !claimed_[k];
+    if (exclusive < keep * best || exclusive < options_.min_support) continue;
+    for (int k : scratch_) claimed_[k] = 1;
+    LineFit fit;
+    fit.line = line;
+    fit.support = support;
+    fit.inlier_begin = static_cast<int>(inliers_.size());
+    inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.end());
+    candidates_.push_back(fit);
+  }
+  // Insertion sort (a handful of candidates; std::stable_sort would allocate a buffer).
+  for (std::size_t i = 1; i < candidates_.size(); ++i)
+    for (std::size_t j = i; j > 0 && candidates_[j].support > candidates_[j - 1].support; --j)
+      std::swap(candidates_[j], candidates_[j - 1]);
+  if (!candidates_.empty()) {
+    const int top = candidates_.front().support;
+    int kept = 0;
+    while (kept < static_cast<int>(candidates_.size()) && kept < max_keep && candidates_[kept].support >= keep * top) ++kept;
+    candidates_.resize(kept);
+  }
+  return static_cast<int>(candidates_.size());
+}
+
+}  // namespace epichead::vision

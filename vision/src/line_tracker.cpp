@@ -1,0 +1,87 @@
+#include "epichead/vision/line_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epichead::vision {
+
+LineTracker::LineTracker(const LineTrackerOptions& options)
+    : options_(options), window_(options.window), detector_(options.epic, options.window) {}
+
+void LineTracker::reset() {
+  for (LineFeature& f : features_) {
+    f.refs = {};
+    f.has_previous = false;
+    f.visible = f.found = false;
+    f.selected = -1;
+  }
+}
+
+void LineTracker::track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
+  int max_edge = -1;
+  for (const VisibleEdge& e : visible.edges) max_edge = std::max(max_edge, e.edge);
+  if (max_edge >= static_cast<int>(features_.size())) {  // first frame (warm-up)
+    features_.resize(static_cast<std::size_t>(max_edge) + 1);
+    longest_.resize(features_.size());
+  }
+  std::fill(longest_.begin(), longest_.end(), -1);
+  for (int i = 0; i < static_cast<int>(visible.edges.size()); ++i) {
+    const VisibleEdge& e = visible.edges[i];
+    if (e.edge < 0 || e.kind == EdgeKind::CylinderSilhouette) continue;  // cylinders index another table
+    int& best = longest_[e.edge];
+    if (best < 0 || (e.b_px - e.a_px).squaredNorm() > (visible.edges[best].b_px - visible.edges[best].a_px).squaredNorm())
+      best = i;
+  }
+  for (int k = 0; k < static_cast<int>(features_.size()); ++k) {
+    LineFeature& f = features_[k];
+    f.edge = k;
+    f.visible = f.found = false;
+    f.selected = -1;
+    if (longest_[k] < 0) { f.has_previous = false; continue; }  // hidden: re-project when it returns
+    track_one(image, visible.edges[longest_[k]], placement, f);
+  }
+}
+
+void LineTracker::track_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f) {
+  if (!f.reserved) {
+    f.result.reserve(options_.window, options_.epic.ransac);
+    f.reserved = true;
+  }
+  f.side = piece.side;
+  if (!f.refs.initialised && options_.mode != EpicMode::Gradient) {
+    // References from the object side of the projected edge, whatever the placement.
+    if (window_.sample(image, piece.a_px, piece.b_px)) detector_.init_references(window_, piece.side, f.refs);
+  }
+  Eigen::Vector2d a = piece.a_px, b = piece.b_px;
+  if (placement == WindowPlacement::Previous && f.has_previous) {
+    a = f.previous_a_px;
+    b = f.previous_b_px;
+    // Keep the projection's direction so that its ObjectSide applies.
+    if ((b - a).dot(piece.b_px - piece.a_px) < 0) std::swap(a, b);
+  }
+  f.window_a_px = a;
+  f.window_b_px = b;
+  if (!window_.sample(image, a, b)) {
+    f.result.candidates.clear();
+    f.has_previous = false;
+    return;
+  }
+  f.visible = true;
+  detector_.detect(window_, piece.side, f.refs, options_.mode, f.result);
+  const int rows = window_.geometry().rows;
+  const int need = std::max(options_.epic.ransac.min_support,
+                            static_cast<int>(std::ceil(options_.min_support_ratio * static_cast<float>(rows))));
+  if (f.result.found() && f.result.candidates.front().support >= need) {
+    const LineCandidate& c = f.result.candidates.front();
+    f.found = true;
+    f.selected = 0;
+    f.has_previous = true;
+    f.previous_a_px = c.a_px;
+    f.previous_b_px = c.b_px;
+    if (options_.mode != EpicMode::Gradient) detector_.update_references(f.result, c, piece.side, f.refs);
+  } else {
+    f.has_previous = false;  // lost: the next window goes back to the projection (recovery)
+  }
+}
+
+}  // namespace epichead::vision

@@ -1,0 +1,106 @@
+#include "epichead/vision/line_window.h"
+
+#include <algorithm>
+#include <cmath>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace epichead::vision {
+
+RowPlan plan_rows(double length_px, const WindowOptions& options) {
+  RowPlan plan;
+  if (!std::isfinite(length_px) || length_px < 1.0) return plan;
+  const int max_rows = std::max(2, options.max_rows);
+  // Smallest power of two that brings the row count to max_rows or below; for a line longer
+  // than max_rows this leaves at least max_rows / 2 rows (20..40 with the default).
+  double step = 1;
+  while (length_px / step > max_rows && step < 1e6) step *= 2;
+  plan.step_px = step;
+  plan.rows = std::clamp(static_cast<int>(std::floor(length_px / step)), 2, max_rows);
+  return plan;
+}
+
+LineWindow::LineWindow(const WindowOptions& options) : options_(options) {
+  options_.width_px = std::clamp(options_.width_px, 8, kMaxWindowWidth);
+  options_.max_rows = std::max(options_.max_rows, 2);
+  capacity_ = options_.width_px * options_.max_rows;
+  planes_.assign(static_cast<std::size_t>(kCueChannels) * capacity_, 0.0f);
+}
+
+bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, const Eigen::Vector2d& b_px) {
+  geometry_.rows = 0;
+  colour_ = image.colour();
+  const Eigen::Vector2d d = b_px - a_px;
+  const double length = d.norm();
+  if (!a_px.allFinite() || !b_px.allFinite() || image.width_px() < 2 || image.height_px() < 2) return false;
+  const RowPlan plan = plan_rows(length, options_);
+  if (plan.rows == 0) return false;
+  WindowGeometry& g = geometry_;
+  g.a_px = a_px;
+  g.along = d / length;
+  g.across = Eigen::Vector2d(-g.along.y(), g.along.x());  // toward ObjectSide::Right
+  g.length_px = length;
+  g.step_px = plan.step_px;
+  g.s0_px = 0.5 * (length - (plan.rows - 1) * plan.step_px);
+  g.cols = options_.width_px;
+  g.rows = plan.rows;
+
+  const int w = image.width_px(), h = image.height_px();
+  const float* px = image.pixels();
+  float* pi = plane(CueChannel::Intensity);
+  float* pr = plane(CueChannel::ChromaR);
+  float* pg = plane(CueChannel::ChromaG);
+  float* pt = plane(CueChannel::Texture);
+  const float ax = static_cast<float>(g.across.x()), ay = static_cast<float>(g.across.y());
+  // The window is a parallelogram: inside the image (with the +1 bilinear neighbour) when its
+  // four corners are. Then no per-pixel clamp is needed.
+  bool inside = true;
+  for (int r : {0, g.rows - 1})
+    for (int c : {0, g.cols - 1}) {
+      const Eigen::Vector2d p = g.to_image(g.x_of_col(c), g.s_of_row(r));
+      inside = inside && p.x() >= 0 && p.y() >= 0 && p.x() < w - 1.01 && p.y() < h - 1.01;
+    }
+  const float xmax = static_cast<float>(w - 1) - 1e-3f, ymax = static_cast<float>(h - 1) - 1e-3f;
+  const std::size_t stride = 4 * static_cast<std::size_t>(w);
+  for (int r = 0; r < g.rows; ++r) {
+    const Eigen::Vector2d p0 = g.to_image(g.x_of_col(0), g.s_of_row(r));
+    const float x0 = static_cast<float>(p0.x()), y0 = static_cast<float>(p0.y());
+    const int base = r * g.cols;
+    for (int c = 0; c < g.cols; ++c) {
+      float x = x0 + static_cast<float>(c) * ax, y = y0 + static_cast<float>(c) * ay;
+      if (!inside) {  // uniform per window: predicted perfectly
+        x = std::clamp(x, 0.0f, xmax);
+        y = std::clamp(y, 0.0f, ymax);
+      }
+      const int ix = static_cast<int>(x), iy = static_cast<int>(y);  // x, y >= 0: truncation floors
+      const float fx = x - static_cast<float>(ix), fy = y - static_cast<float>(iy);
+      const float* q0 = px + 4 * (static_cast<std::size_t>(iy) * w + ix);
+      const float* q1 = q0 + stride;
+#if defined(__SSE2__)
+      // All four channels of a tap in one register: lerp along x on both rows, then along y.
+      const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy);
+      const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
+      const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
+      const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
+      const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
+      alignas(16) float v[4];
+      _mm_store_ps(v, _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top))));
+#else
+      float v[4];
+      for (int k = 0; k < 4; ++k) {
+        const float t = q0[k] + fx * (q0[4 + k] - q0[k]), b = q1[k] + fx * (q1[4 + k] - q1[k]);
+        v[k] = t + fy * (b - t);
+      }
+#endif
+      pi[base + c] = v[0];
+      pr[base + c] = v[1];
+      pg[base + c] = v[2];
+      pt[base + c] = v[3];
+    }
+  }
+  return true;
+}
+
+}  // namespace epichead::vision

@@ -1,0 +1,366 @@
+// Robust pose by iteratively reweighted Levenberg-Marquardt on SE(3).
+//
+// All residuals are normalised by their feature's sigma, so lines, junctions, ellipse points
+// and 3D points mix in one cost. The normal equations are accumulated row by row into a 6x6
+// system (no Jacobian matrix is stored), which keeps the solver allocation-free.
+//
+// Line residual: the signed distance of an edgel from the projected model line, computed in
+// undistorted normalised coordinates (where a 3D line stays straight) and scaled to pixels by
+// the focal length. With l = A_cam x B_cam (the line through the two projected end points,
+// homogeneous), r = l . x / |l_xy|.
+#include "epichead/vision/pose_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+namespace epichead::vision {
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using RowJ = Eigen::Matrix<double, 1, 6>;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// d(exp(xi) X)/d(xi) at xi = 0 for xi = (translation, rotation).
+Eigen::Matrix<double, 3, 6> point_jacobian(const Eigen::Vector3d& X) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>().setIdentity();
+  J.rightCols<3>() = -skew(X);
+  return J;
+}
+
+// The conic of a circle's image in normalised coordinates (inside negative).
+Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::Isometry3d& cam_T_obj) {
+  const Eigen::Vector3d c = cam_T_obj * circle.centre_obj;
+  const Eigen::Vector3d n = cam_T_obj.linear() * circle.normal_obj.normalized();
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  Eigen::Matrix3d Q;
+  Q << circle.radius_m * u, circle.radius_m * v, c;
+  const Eigen::Matrix3d Qi = Q.inverse();
+  return Qi.transpose() * Eigen::Vector3d(1, 1, -1).asDiagonal() * Qi;
+}
+
+// First-order geometric distance of x from the conic C (normalised coordinates).
+double conic_distance(const Eigen::Matrix3d& C, const Eigen::Vector2d& x) {
+  const Eigen::Vector3d h(x.x(), x.y(), 1);
+  const Eigen::Vector3d g = C * h;
+  const double grad = 2 * std::hypot(g.x(), g.y());
+  return grad > 0 ? h.dot(g) / grad : 0.0;
+}
+
+double tukey_weight(double u, double c) {
+  if (std::abs(u) >= c) return 0;
+  const double t = 1 - (u / c) * (u / c);
+  return t * t;
+}
+
+double tukey_rho(double r, double c) {
+  if (std::abs(r) >= c) return c * c / 6;
+  const double t = 1 - (r / c) * (r / c);
+  return c * c / 6 * (1 - t * t * t);
+}
+
+double median_in_place(std::vector<double>& v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+void PoseProblem::clear() {
+  lines.clear();
+  points.clear();
+  ellipses.clear();
+  points_3d.clear();
+}
+
+const char* to_string(PoseStatus status) {
+  switch (status) {
+    case PoseStatus::Ok: return "ok";
+    case PoseStatus::TooFewFeatures: return "too_few_features";
+    case PoseStatus::Degenerate: return "degenerate";
+    case PoseStatus::Diverged: return "diverged";
+  }
+  return "unknown";
+}
+
+Eigen::Isometry3d apply_left(const Vector6d& xi, const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d rho = xi.head<3>(), phi = xi.tail<3>();
+  const double angle = phi.norm();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity(), V = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d W = skew(phi);
+  if (angle > 1e-12) {
+    const double a = std::sin(angle) / angle, b = (1 - std::cos(angle)) / (angle * angle),
+                 c = (angle - std::sin(angle)) / (angle * angle * angle);
+    R += a * W + b * W * W;
+    V += b * W + c * W * W;
+  } else {
+    R += W;
+    V += 0.5 * W;
+  }
+  Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();
+  delta.linear() = R;
+  delta.translation() = V * rho;
+  Eigen::Isometry3d out = delta * pose;
+  // Re-orthonormalise to keep round-off from accumulating over many updates.
+  out.linear() = Eigen::Quaterniond(out.linear()).normalized().toRotationMatrix();
+  return out;
+}
+
+PoseEstimator::PoseEstimator(const Camera& camera, const PoseOptions& options) : camera_(camera), options_(options) {
+  residual_scratch_.reserve(4096);
+}
+
+void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d& prior, PoseResult& out) {
+  out.cam_T_obj = prior;
+  out.status = PoseStatus::Ok;
+  out.reason.clear();
+  out.iterations = 0;  // LM iterations over all rounds
+  out.inliers = out.outliers = 0;
+  out.residuals.clear();
+  const double focal = 0.5 * (camera_.intrinsics().fx_px + camera_.intrinsics().fy_px);
+
+  int features = 0, dims = 0;
+  for (const auto& l : problem.lines) if (l.edgels_px.size() >= 2) { ++features; dims += 2; }
+  features += static_cast<int>(problem.points.size());
+  dims += 2 * static_cast<int>(problem.points.size());
+  for (const auto& e : problem.ellipses) if (e.points_px.size() >= 5) { ++features; dims += 5; }
+  features += static_cast<int>(problem.points_3d.size());
+  dims += 3 * static_cast<int>(problem.points_3d.size());
+  if (features < 3 || dims < 6) {
+    out.status = PoseStatus::TooFewFeatures;
+    out.reason = std::to_string(features) + " usable features (need 3 or more)";
+    return;
+  }
+
+  // Visits every residual (normalised by its sigma) with its Jacobian row and feature slot.
+  // With want_jacobian false, J is left untouched (cheaper cost evaluation).
+  auto visit = [&](const Eigen::Isometry3d& pose, bool want_jacobian, auto&& fn) {
+    int slot = 0;
+    for (const auto& obs : problem.lines) {
+      if (obs.edgels_px.size() < 2 || rejected_[slot]) { ++slot; continue; }
+      const Eigen::Vector3d A = pose * obs.a_obj, B = pose * obs.b_obj;
+      const Eigen::Vector3d l = A.cross(B);
+      const double s = std::hypot(l.x(), l.y());
+      Eigen::Matrix<double, 3, 6> dl = Eigen::Matrix<double, 3, 6>::Zero();
+      if (want_jacobian) dl = -skew(B) * point_jacobian(A) + skew(A) * point_jacobian(B);
+      for (const auto& q : obs.edgels_px) {
+        const Eigen::Vector2d xn = camera_.pixel_to_normalized(q);
+        const Eigen::Vector3d x(xn.x(), xn.y(), 1);
+        const double ldx = l.dot(x);
+        const double r = focal * ldx / s / obs.sigma_px;
+        RowJ J;
+        if (want_jacobian) {
+          const Eigen::Vector3d dr_dl = (x / s - ldx / (s * s * s) * Eigen::Vector3d(l.x(), l.y(), 0)) * focal / obs.sigma_px;
+          J = dr_dl.transpose() * dl;
+        }
+        fn(r, J, slot);
+      }
+      ++slot;
+    }
+    for (const auto& obs : problem.points) {
+      if (rejected_[slot]) { ++slot; continue; }
+      const Eigen::Vector3d X = pose * obs.p_obj;
+      const Eigen::Vector2d xn(X.x() / X.z(), X.y() / X.z());
+      const Eigen::Vector2d r = (camera_.normalized_to_pixel(xn) - obs.px) / obs.sigma_px;
+      Eigen::Matrix<double, 2, 6> J2;
+      if (want_jacobian) {
+        Eigen::Matrix<double, 2, 3> dn;
+        dn << 1 / X.z(), 0, -X.x() / (X.z() * X.z()), 0, 1 / X.z(), -X.y() / (X.z() * X.z());
+        J2 = camera_.normalized_to_pixel_jacobian(xn) * dn * point_jacobian(X) / obs.sigma_px;
+      }
+      fn(r.x(), RowJ(J2.row(0)), slot);
+      fn(r.y(), RowJ(J2.row(1)), slot);
+      ++slot;
+    }
+    for (const auto& obs : problem.ellipses) {
+      if (obs.points_px.size() < 5 || rejected_[slot]) { ++slot; continue; }
+      // Numerical Jacobian: six perturbed conics per ellipse, shared by all its points.
+      const Eigen::Matrix3d C = circle_conic_normalized(obs.circle, pose);
+      Eigen::Matrix3d Cd[6];
+      constexpr double h = 1e-6;
+      if (want_jacobian) {
+        for (int k = 0; k < 6; ++k) {
+          Vector6d xi = Vector6d::Zero();
+          xi[k] = h;
+          Cd[k] = circle_conic_normalized(obs.circle, apply_left(xi, pose));
+        }
+      }
+      for (const auto& q : obs.points_px) {
+        const Eigen::Vector2d xn = camera_.pixel_to_normalized(q);
+        const double r = focal * conic_distance(C, xn) / obs.sigma_px;
+        RowJ J;
+        if (want_jacobian)
+          for (int k = 0; k < 6; ++k) J[k] = (focal * conic_distance(Cd[k], xn) / obs.sigma_px - r) / h;
+        fn(r, J, slot);
+      }
+      ++slot;
+    }
+    for (const auto& obs : problem.points_3d) {
+      if (rejected_[slot]) { ++slot; continue; }
+      const Eigen::Vector3d X = pose * obs.p_obj;
+      const Eigen::Vector3d r = (X - obs.p_cam) / obs.sigma_m;
+      Eigen::Matrix<double, 3, 6> J3;
+      if (want_jacobian) J3 = point_jacobian(X) / obs.sigma_m;
+      for (int i = 0; i < 3; ++i) fn(r[i], RowJ(J3.row(i)), slot);
+      ++slot;
+    }
+  };
+
+  auto all_in_front = [&](const Eigen::Isometry3d& pose) {
+    for (const auto& obs : problem.lines) if ((pose * obs.a_obj).z() <= 0 || (pose * obs.b_obj).z() <= 0) return false;
+    for (const auto& obs : problem.points) if ((pose * obs.p_obj).z() <= 0) return false;
+    return true;
+  };
+
+  // Robust scale from the median absolute residual at the current pose.
+  auto robust_scale = [&](const Eigen::Isometry3d& pose) {
+    residual_scratch_.clear();
+    visit(pose, false, [&](double r, const RowJ&, int) { residual_scratch_.push_back(std::abs(r)); });
+    return std::max(options_.min_scale_px, 1.4826 * median_in_place(residual_scratch_));
+  };
+
+  const std::size_t slots = problem.lines.size() + problem.points.size() + problem.ellipses.size() + problem.points_3d.size();
+  rejected_.assign(slots, 0);
+  feature_sq_.assign(slots, 0.0);
+  feature_n_.assign(slots, 0.0);
+  // Per-feature normalised RMS at `pose` over every feature (rejected ones too).
+  auto feature_rms = [&](const Eigen::Isometry3d& pose) {
+    std::fill(feature_sq_.begin(), feature_sq_.end(), 0.0);
+    std::fill(feature_n_.begin(), feature_n_.end(), 0.0);
+    std::swap(rejected_, rejected_spare_);
+    rejected_.assign(slots, 0);
+    visit(pose, false, [&](double r, const RowJ&, int slot) { feature_sq_[slot] += r * r; feature_n_[slot] += 1; });
+    std::swap(rejected_, rejected_spare_);
+    for (std::size_t i = 0; i < slots; ++i) feature_sq_[i] = feature_n_[i] > 0 ? std::sqrt(feature_sq_[i] / feature_n_[i]) : 0;
+  };
+
+  Eigen::Isometry3d pose = prior;
+  double scale = 1;
+  Matrix6d H = Matrix6d::Zero();
+  // Rounds of IRLS; after each, whole features whose RMS residual is far beyond the robust
+  // scale are rejected (a wrong candidate line moves all its edgels together, which a
+  // per-residual kernel alone can average into a wrong compromise), and the pose is re-solved.
+  // Graduated non-convexity: the kernel width starts at what the residuals of the prior need
+  // (robust scale from the MAD) and shrinks each iteration toward the width the features'
+  // sigmas call for. Taking the MAD at every iteration instead lets a pose biased by many
+  // outliers inflate its own scale and stay there.
+  const double c_floor = options_.tukey_c * options_.min_scale_px;
+  double c = std::max(c_floor, options_.tukey_c * robust_scale(pose));
+  for (int round = 0; round < options_.max_rejection_rounds; ++round) {
+  double lambda = 1e-3;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    out.iterations += 1;
+    H.setZero();
+    Vector6d g = Vector6d::Zero();
+    visit(pose, true, [&](double r, const RowJ& J, int) {
+      const double w = tukey_weight(r, c);
+      H.noalias() += w * J.transpose() * J;
+      g.noalias() += w * J.transpose() * r;
+    });
+    if (!H.allFinite() || !g.allFinite()) {
+      out.status = PoseStatus::Diverged;
+      out.reason = "non-finite residuals or Jacobian";
+      out.cam_T_obj = prior;
+      return;
+    }
+    // The cost with the weights of this iteration held fixed (IRLS inner problem).
+    // Tukey's robust cost at the scale of this iteration: a step is taken only if it lowers it.
+    auto weighted_cost = [&](const Eigen::Isometry3d& p) {
+      double sum = 0;
+      visit(p, false, [&](double r, const RowJ&, int) { sum += tukey_rho(r, c); });
+      return sum;
+    };
+    const double base = weighted_cost(pose);
+    bool improved = false;
+    Vector6d step = Vector6d::Zero();
+    for (int tries = 0; tries < 8; ++tries) {
+      Matrix6d A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
+      step = -A.ldlt().solve(g);
+      if (!step.allFinite()) break;
+      const Eigen::Isometry3d candidate = apply_left(step, pose);
+      if (all_in_front(candidate) && weighted_cost(candidate) <= base) {
+        pose = candidate;
+        lambda = std::max(1e-7, lambda / 10);
+        improved = true;
+        break;
+      }
+      lambda *= 10;
+    }
+    const bool at_floor = c <= c_floor;
+    c = std::max(c_floor, c / 1.5);
+    if (at_floor && (!improved || step.norm() < options_.convergence_step)) break;
+  }
+  scale = std::max(options_.min_scale_px, robust_scale(pose));
+  feature_rms(pose);
+  // Reject the worst remaining feature if it is an outlier; one at a time, since one gross
+  // outlier can make good features look bad until it is gone.
+  int worst = -1;
+  double worst_rms = options_.outlier_sigma * scale;
+  int remaining = 0;
+  for (std::size_t i = 0; i < slots; ++i) {
+    if (rejected_[i] || feature_n_[i] == 0) continue;
+    ++remaining;
+    if (feature_sq_[i] > worst_rms) { worst_rms = feature_sq_[i]; worst = static_cast<int>(i); }
+  }
+  if (worst < 0 || remaining <= 3) break;
+  rejected_[worst] = 1;
+  }
+
+  // Final weights, degeneracy check, covariance and per-feature residuals at the solution.
+  scale = std::max(options_.min_scale_px, robust_scale(pose));
+  c = options_.tukey_c * scale;
+  H.setZero();
+  double wr2 = 0, wsum = 0;
+  visit(pose, true, [&](double r, const RowJ& J, int) {
+    const double w = tukey_weight(r, c);
+    H.noalias() += w * J.transpose() * J;
+    wr2 += w * r * r;
+    wsum += w;
+  });
+  out.cam_T_obj = pose;
+  out.scale_px = scale;
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(H);
+  const double max_ev = eig.eigenvalues().maxCoeff(), min_ev = eig.eigenvalues().minCoeff();
+  if (!(min_ev > 0) || max_ev / min_ev > options_.max_condition) {
+    out.status = PoseStatus::Degenerate;
+    const Vector6d weak = eig.eigenvectors().col(0);
+    int axis = 0;
+    weak.cwiseAbs().maxCoeff(&axis);
+    static const char* names[6] = {"x translation", "y translation", "z translation", "x rotation", "y rotation", "z rotation"};
+    out.reason = std::string("features do not constrain the pose; weakest direction mostly ") + names[axis];
+  }
+  const double sigma2 = std::max(1.0, wsum > 6 ? wr2 / (wsum - 6) : 1.0);
+  out.covariance = out.status == PoseStatus::Ok ? Matrix6d(sigma2 * H.inverse()) : Matrix6d(Matrix6d::Identity() * 1e6);
+
+  // Per-feature RMS (pixels for image features, metres for 3D points) and inlier flags.
+  feature_rms(pose);
+  out.residuals.resize(slots);
+  std::size_t slot = 0;
+  auto finish = [&](int feature, double sigma) {
+    FeatureResidual& fr = out.residuals[slot];
+    fr.feature = feature;
+    fr.inlier = feature_n_[slot] > 0 && !rejected_[slot] && feature_sq_[slot] <= options_.outlier_sigma * scale;
+    fr.rms = feature_sq_[slot] * sigma;
+    (fr.inlier ? out.inliers : out.outliers) += 1;
+    ++slot;
+  };
+  for (const auto& o : problem.lines) finish(o.feature, o.sigma_px);
+  for (const auto& o : problem.points) finish(o.feature, o.sigma_px);
+  for (const auto& o : problem.ellipses) finish(o.feature, o.sigma_px);
+  for (const auto& o : problem.points_3d) finish(o.feature, o.sigma_m);
+}
+
+}  // namespace epichead::vision
