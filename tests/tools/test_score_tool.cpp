@@ -15,6 +15,7 @@
 
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
+#include "common/temp_dir.h"
 
 using namespace epichead::vision;
 
@@ -22,20 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("epichead_test_score_tool_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string operator/(const std::string& name) const { return (path / name).string(); }
+struct TempDir : epichead::testing::TempDir {
+  TempDir() : epichead::testing::TempDir("epichead_test_score_tool") {}
 };
 
 struct Run {

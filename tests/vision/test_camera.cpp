@@ -11,6 +11,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "epichead/vision/camera.h"
+#include "common/temp_dir.h"
 
 using epichead::vision::Camera;
 using epichead::vision::Distortion;
@@ -20,25 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh directory under the system temp dir, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("epichead_test_camera_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = path / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+struct TempDir : epichead::testing::TempDir {
+  TempDir() : epichead::testing::TempDir("epichead_test_camera") {}
 };
 
 // Wide-angle barrel distortion with tangential terms: the image corner (r ~ 0.8) lies close to

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "epichead/vision/sequence.h"
+#include "common/temp_dir.h"
 
 using namespace epichead::vision;
 
@@ -18,24 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("epichead_test_sequence_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string str() const { return path.string(); }
-  void write(const std::string& name, const std::string& text) const {
-    fs::create_directories((path / name).parent_path());
-    std::ofstream(path / name, std::ios::binary) << text;
-  }
+struct TempDir : epichead::testing::TempDir {
+  TempDir() : epichead::testing::TempDir("epichead_test_sequence") {}
 };
 
 const std::string kShared = EPICHEAD_SHARED_DATA;

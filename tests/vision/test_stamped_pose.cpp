@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "epichead/vision/stamped_pose.h"
+#include "common/temp_dir.h"
 
 using epichead::vision::make_pose;
 using epichead::vision::read_pose_csv;
@@ -17,24 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("epichead_test_stamped_pose_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = path / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+struct TempDir : epichead::testing::TempDir {
+  TempDir() : epichead::testing::TempDir("epichead_test_stamped_pose") {}
 };
 
 const std::string kHeader = "frame,t_s,tx,ty,tz,qw,qx,qy,qz\n";

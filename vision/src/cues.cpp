@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__SSE4_1__)
+#include <immintrin.h>
+#endif
+
 namespace epichead::vision {
 namespace {
 
@@ -45,6 +49,53 @@ float cue_agreement(const IntervalCues& cues, const CueReference& ref, bool colo
   return sum;
 }
 
+#if defined(__SSE4_1__)
+namespace {
+// exp_neg on four lanes: the same operations in the same order, so the same values.
+inline __m128 exp_neg4(__m128 x) {
+  x = _mm_max_ps(x, _mm_set1_ps(-80.0f));
+  const __m128 t = _mm_mul_ps(x, _mm_set1_ps(1.44269504f));
+  const __m128 fi = _mm_floor_ps(t);
+  const __m128 f = _mm_sub_ps(t, fi);
+  __m128 p = _mm_add_ps(_mm_set1_ps(0.00133335581f), _mm_mul_ps(f, _mm_set1_ps(0.000154035304f)));
+  p = _mm_add_ps(_mm_set1_ps(0.00961812911f), _mm_mul_ps(f, p));
+  p = _mm_add_ps(_mm_set1_ps(0.0555041087f), _mm_mul_ps(f, p));
+  p = _mm_add_ps(_mm_set1_ps(0.240226507f), _mm_mul_ps(f, p));
+  p = _mm_add_ps(_mm_set1_ps(0.693147181f), _mm_mul_ps(f, p));
+  p = _mm_add_ps(_mm_set1_ps(1.0f), _mm_mul_ps(f, p));
+  const __m128i bits = _mm_slli_epi32(_mm_add_epi32(_mm_cvttps_epi32(fi), _mm_set1_epi32(127)), 23);
+  return _mm_mul_ps(p, _mm_castsi128_ps(bits));
+}
+}  // namespace
+#endif
+
+void cue_agreements(const IntervalCues* cues, int n, const CueReference& ref, bool colour, float* out) {
+  int j = 0;
+#if defined(__SSE4_1__)
+  const __m128 mu0 = _mm_set1_ps(ref.mu[0]), mu1 = _mm_set1_ps(ref.mu[1]), mu2 = _mm_set1_ps(ref.mu[2]),
+               mu3 = _mm_set1_ps(ref.mu[3]);
+  const __m128 k0 = _mm_set1_ps(inv_two_var(ref.sigma[0])), k1 = _mm_set1_ps(inv_two_var(ref.sigma[1])),
+               k2 = _mm_set1_ps(inv_two_var(ref.sigma[2])), k3 = _mm_set1_ps(inv_two_var(ref.sigma[3]));
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  for (; j + 4 <= n; j += 4) {
+    __m128 v0 = _mm_loadu_ps(cues[j].value.data()), v1 = _mm_loadu_ps(cues[j + 1].value.data());
+    __m128 v2 = _mm_loadu_ps(cues[j + 2].value.data()), v3 = _mm_loadu_ps(cues[j + 3].value.data());
+    _MM_TRANSPOSE4_PS(v0, v1, v2, v3);  // v_k: channel k of the four intervals
+    const __m128 d0 = _mm_sub_ps(mu0, v0), d1 = _mm_sub_ps(mu1, v1), d2 = _mm_sub_ps(mu2, v2), d3 = _mm_sub_ps(mu3, v3);
+    __m128 sum = _mm_add_ps(exp_neg4(_mm_mul_ps(_mm_mul_ps(_mm_xor_ps(d0, sign), d0), k0)),
+                            exp_neg4(_mm_mul_ps(_mm_mul_ps(_mm_xor_ps(d3, sign), d3), k3)));
+    if (colour) {
+      const __m128 e = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(d1, d1), k1), _mm_mul_ps(_mm_mul_ps(d2, d2), k2));
+      sum = _mm_add_ps(sum, exp_neg4(_mm_xor_ps(e, sign)));
+    }
+    const __m128 valid = _mm_castsi128_ps(_mm_cmpgt_epi32(
+        _mm_setr_epi32(cues[j].valid, cues[j + 1].valid, cues[j + 2].valid, cues[j + 3].valid), _mm_setzero_si128()));
+    _mm_storeu_ps(out + j, _mm_and_ps(valid, sum));
+  }
+#endif
+  for (; j < n; ++j) out[j] = cue_agreement(cues[j], ref, colour);
+}
+
 CueHistograms::CueHistograms(const CueOptions& options) : options_(options) {
   options_.intensity_bins = std::clamp(options_.intensity_bins, 2, 256);
   options_.chroma_bins = std::clamp(options_.chroma_bins, 2, 64);
@@ -62,9 +113,8 @@ void CueHistograms::prepare(const LineWindow& window) {
   const int n = g.rows * g.cols;
   if (n > capacity_) {  // first window (or a larger one): warm-up only
     capacity_ = std::max(n, window.options().width_px * window.options().max_rows);
-    bin_i_.resize(capacity_);
-    bin_t_.resize(capacity_);
-    bin_c_.resize(capacity_);
+    bins_.resize(capacity_);
+    values_.resize(4 * static_cast<std::size_t>(capacity_));
   }
   const float* I = window.plane(CueChannel::Intensity);
   const float* R = window.plane(CueChannel::ChromaR);
@@ -74,15 +124,32 @@ void CueHistograms::prepare(const LineWindow& window) {
   const float si = ni / 256.0f, sc = nc / 256.0f, st = nt / options_.texture_range;
   // Clamped in float, then truncated: branch-free, so the loop vectorises.
   const float top_i = ni - 0.5f, top_c = nc - 0.5f, top_t = nt - 0.5f;
-  std::uint16_t* __restrict bi = bin_i_.data();
-  std::uint16_t* __restrict bt = bin_t_.data();
-  std::uint16_t* __restrict bc = bin_c_.data();
+  std::uint64_t* __restrict bins = bins_.data();
   auto clampf = [](float v, float hi) { v = v > 0.0f ? v : 0.0f; return v < hi ? v : hi; };
   for (int p = 0; p < n; ++p) {
-    bi[p] = static_cast<std::uint16_t>(static_cast<int>(clampf(I[p] * si, top_i)));
-    bt[p] = static_cast<std::uint16_t>(static_cast<int>(clampf(T[p] * st, top_t)));
-    bc[p] = static_cast<std::uint16_t>(static_cast<int>(clampf(R[p] * sc, top_c)) * nc +
-                                       static_cast<int>(clampf(G[p] * sc, top_c)));
+    const auto bi = static_cast<std::uint32_t>(static_cast<int>(clampf(I[p] * si, top_i)));
+    const auto bt = static_cast<std::uint32_t>(static_cast<int>(clampf(T[p] * st, top_t)));
+    const auto bc = static_cast<std::uint32_t>(static_cast<int>(clampf(R[p] * sc, top_c)) * nc +
+                                               static_cast<int>(clampf(G[p] * sc, top_c)));
+    bins[p] = (static_cast<std::uint64_t>(bt) << 32) | (bc << 16) | bi;
+  }
+  float* __restrict vals = values_.data();
+  int p = 0;
+#if defined(__SSE4_1__)
+  for (; p + 4 <= n; p += 4) {
+    __m128 a = _mm_loadu_ps(I + p), b = _mm_loadu_ps(R + p), c = _mm_loadu_ps(G + p), d = _mm_loadu_ps(T + p);
+    _MM_TRANSPOSE4_PS(a, b, c, d);
+    _mm_storeu_ps(vals + 4 * p, a);
+    _mm_storeu_ps(vals + 4 * p + 4, b);
+    _mm_storeu_ps(vals + 4 * p + 8, c);
+    _mm_storeu_ps(vals + 4 * p + 12, d);
+  }
+#endif
+  for (; p < n; ++p) {
+    vals[4 * p] = I[p];
+    vals[4 * p + 1] = R[p];
+    vals[4 * p + 2] = G[p];
+    vals[4 * p + 3] = T[p];
   }
 }
 
@@ -93,18 +160,20 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   col_end = std::min(col_end, g.cols);
   if (row < 0 || row >= g.rows || col_end <= col_begin) return out;
   const int p0 = row * g.cols + col_begin, p1 = row * g.cols + col_end;
-  const float* I = window.plane(CueChannel::Intensity);
-  const float* R = window.plane(CueChannel::ChromaR);
-  const float* G = window.plane(CueChannel::ChromaG);
-  const float* T = window.plane(CueChannel::Texture);
   // Pass 1: counts only, tracking each mode (the first bin to reach the top count wins ties).
   // Keeping sums out of this loop shortens its store-to-load chains (neighbouring pixels mostly
   // share a bin).
-  int best_i = bin_i_[p0], best_c = bin_c_[p0], best_t = bin_t_[p0];
+  const std::uint64_t* bins = bins_.data();
+  int best_i = static_cast<int>(bins[p0] & 0xFFFF), best_c = static_cast<int>((bins[p0] >> 16) & 0xFFFF),
+      best_t = static_cast<int>(bins[p0] >> 32);
   int top_i = 0, top_c = 0, top_t = 0;
+  std::uint16_t* const hist_i = count_i_.data();
+  std::uint16_t* const hist_c = count_c_.data();
+  std::uint16_t* const hist_t = count_t_.data();
   for (int p = p0; p < p1; ++p) {
-    const int bi = bin_i_[p], bc = bin_c_[p], bt = bin_t_[p];
-    const int ci = ++count_i_[bi], cc = ++count_c_[bc], ct = ++count_t_[bt];
+    const std::uint64_t q = bins[p];
+    const int bi = static_cast<int>(q & 0xFFFF), bc = static_cast<int>((q >> 16) & 0xFFFF), bt = static_cast<int>(q >> 32);
+    const int ci = ++hist_i[bi], cc = ++hist_c[bc], ct = ++hist_t[bt];
     best_i = ci > top_i ? bi : best_i;
     top_i = ci > top_i ? ci : top_i;
     best_c = cc > top_c ? bc : best_c;
@@ -114,17 +183,41 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   }
   // Pass 2: clear the touched bins and sum the samples of each modal bin (branch-free), so the
   // mode is refined to the mean of its bin (finer than the bin width).
+  std::uint16_t* __restrict ci_ = count_i_.data();
+  std::uint16_t* __restrict cc_ = count_c_.data();
+  std::uint16_t* __restrict ct_ = count_t_.data();
+  const float* vals = values_.data();
+#if defined(__SSE4_1__)
+  // Lanes (I, R, G, T) against the modal bins (intensity, chroma, chroma, texture); each lane
+  // adds in pixel order, so the sums are those of the scalar loop.
+  const __m128i best = _mm_setr_epi32(best_i, best_c, best_c, best_t);
+  __m128 sum = _mm_setzero_ps();
+  for (int p = p0; p < p1; ++p) {
+    const std::uint64_t q = bins[p];
+    ci_[q & 0xFFFF] = 0;
+    cc_[(q >> 16) & 0xFFFF] = 0;
+    ct_[q >> 32] = 0;
+    const __m128i b = _mm_shuffle_epi32(_mm_cvtepu16_epi32(_mm_cvtsi64_si128(static_cast<long long>(q))), 0x94);
+    const __m128 hit = _mm_castsi128_ps(_mm_cmpeq_epi32(b, best));
+    sum = _mm_add_ps(sum, _mm_and_ps(hit, _mm_loadu_ps(vals + 4 * static_cast<std::size_t>(p))));
+  }
+  alignas(16) float s4[4];
+  _mm_store_ps(s4, sum);
+  const float si = s4[0], sr = s4[1], sg = s4[2], st = s4[3];
+#else
   float si = 0, sr = 0, sg = 0, st = 0;
   for (int p = p0; p < p1; ++p) {
-    const int bi = bin_i_[p], bc = bin_c_[p], bt = bin_t_[p];
-    count_i_[bi] = 0;
-    count_c_[bc] = 0;
-    count_t_[bt] = 0;
-    si += bi == best_i ? I[p] : 0.0f;
-    sr += bc == best_c ? R[p] : 0.0f;
-    sg += bc == best_c ? G[p] : 0.0f;
-    st += bt == best_t ? T[p] : 0.0f;
+    const std::uint64_t q = bins[p];
+    const int bi = static_cast<int>(q & 0xFFFF), bc = static_cast<int>((q >> 16) & 0xFFFF), bt = static_cast<int>(q >> 32);
+    ci_[bi] = 0;
+    cc_[bc] = 0;
+    ct_[bt] = 0;
+    si += bi == best_i ? vals[4 * p] : 0.0f;
+    sr += bc == best_c ? vals[4 * p + 1] : 0.0f;
+    sg += bc == best_c ? vals[4 * p + 2] : 0.0f;
+    st += bt == best_t ? vals[4 * p + 3] : 0.0f;
   }
+#endif
   out.value[0] = si / static_cast<float>(top_i);
   out.value[1] = sr / static_cast<float>(top_c);
   out.value[2] = sg / static_cast<float>(top_c);

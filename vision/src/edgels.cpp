@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 namespace epichead::vision {
 
 void EdgelSet::reserve(const WindowOptions& options) {
@@ -52,11 +56,9 @@ void find_edgels(const LineWindow& window, const EdgelOptions& options, EdgelSet
     out.row_begin[r] = static_cast<int>(out.edgels.size());
     const float* d = G + r * cols;
     const float s = static_cast<float>(g.s_of_row(r));
-    for (int c = 2; c < cols - 2; ++c) {
+    auto add = [&](int c) {
       const float a = std::fabs(d[c]);
-      if (a < min_g) continue;
       const float l = std::fabs(d[c - 1]), rr = std::fabs(d[c + 1]);
-      if (!(a > l && a >= rr)) continue;
       const float den = l - 2.0f * a + rr;
       float off = den < 0 ? 0.5f * (l - rr) / den : 0.0f;
       off = std::clamp(off, -0.5f, 0.5f);
@@ -67,7 +69,25 @@ void find_edgels(const LineWindow& window, const EdgelOptions& options, EdgelSet
       e.gradient = d[c];
       e.row = r;
       out.edgels.push_back(e);
+    };
+    auto is_max = [&](int c) {
+      const float a = std::fabs(d[c]);
+      return a >= min_g && a > std::fabs(d[c - 1]) && a >= std::fabs(d[c + 1]);
+    };
+    int c = 2;
+#if defined(__SSE2__)
+    // Four columns per test; most columns are not maxima, so the scalar work is per edgel.
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)), vmin = _mm_set1_ps(min_g);
+    for (; c + 4 <= cols - 2; c += 4) {
+      const __m128 a = _mm_and_ps(abs_mask, _mm_loadu_ps(d + c));
+      const __m128 l = _mm_and_ps(abs_mask, _mm_loadu_ps(d + c - 1));
+      const __m128 rr = _mm_and_ps(abs_mask, _mm_loadu_ps(d + c + 1));
+      const __m128 hit = _mm_and_ps(_mm_cmpge_ps(a, vmin), _mm_and_ps(_mm_cmpgt_ps(a, l), _mm_cmpge_ps(a, rr)));
+      for (int bits = _mm_movemask_ps(hit); bits != 0; bits &= bits - 1) add(c + __builtin_ctz(bits));
     }
+#endif
+    for (; c < cols - 2; ++c)
+      if (is_max(c)) add(c);
   }
   out.row_begin[rows] = static_cast<int>(out.edgels.size());
 }

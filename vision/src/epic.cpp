@@ -100,10 +100,10 @@ void EpicDetector::likelihoods(EpicResult& out, ObjectSide side, const FeatureRe
   // W = cues * (w_left + w_right). Each interval is compared once with each used reference.
   const float wl = weight_left(side), wr = weight_right(side);
   const int ni = static_cast<int>(out.intervals.size());
-  for (int j = 0; j < ni; ++j) {
-    agree_left_[j] = wl > 0 ? cue_agreement(out.intervals[j], refs.side[0], colour) : 0.0f;
-    agree_right_[j] = wr > 0 ? cue_agreement(out.intervals[j], refs.side[1], colour) : 0.0f;
-  }
+  if (wl > 0) cue_agreements(out.intervals.data(), ni, refs.side[0], colour, agree_left_.data());
+  else std::fill(agree_left_.begin(), agree_left_.begin() + ni, 0.0f);
+  if (wr > 0) cue_agreements(out.intervals.data(), ni, refs.side[1], colour, agree_right_.data());
+  else std::fill(agree_right_.begin(), agree_right_.begin() + ni, 0.0f);
   const float inv_w = 1.0f / (static_cast<float>(cue_count(colour)) * (wl + wr));
   for (Edgel& e : out.edgels.edgels)
     e.likelihood = (agree_left_[e.left_interval] + agree_right_[e.left_interval + 1]) * inv_w;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__SSE2__)
+#include <cstdint>
+
+#if defined(__SSE4_1__)
 #include <immintrin.h>
 #endif
 
@@ -64,36 +66,73 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
     }
   const float xmax = static_cast<float>(w - 1) - 1e-3f, ymax = static_cast<float>(h - 1) - 1e-3f;
   const std::size_t stride = 4 * static_cast<std::size_t>(w);
+  // One bilinear tap: all four channels in one register, lerp along x on both rows, then along y.
+  auto tap = [&](float x, float y, float v[4]) {
+    const int ix = static_cast<int>(x), iy = static_cast<int>(y);  // x, y >= 0: truncation floors
+    const float fx = x - static_cast<float>(ix), fy = y - static_cast<float>(iy);
+    const float* q0 = px + 4 * (static_cast<std::size_t>(iy) * w + ix);
+    const float* q1 = q0 + stride;
+    for (int k = 0; k < 4; ++k) {
+      const float t = q0[k] + fx * (q0[4 + k] - q0[k]), b = q1[k] + fx * (q1[4 + k] - q1[k]);
+      v[k] = t + fy * (b - t);
+    }
+  };
   for (int r = 0; r < g.rows; ++r) {
     const Eigen::Vector2d p0 = g.to_image(g.x_of_col(0), g.s_of_row(r));
     const float x0 = static_cast<float>(p0.x()), y0 = static_cast<float>(p0.y());
     const int base = r * g.cols;
-    for (int c = 0; c < g.cols; ++c) {
+    int c = 0;
+#if defined(__SSE4_1__)
+    // Four pixels per pass: the coordinates, floors and fractions of four columns in one
+    // register each, four all-channel taps, then a 4x4 transpose into the four planes
+    // (the same arithmetic as the scalar tap, so the same values).
+    {
+      const __m128 vx0 = _mm_set1_ps(x0), vy0 = _mm_set1_ps(y0);
+      const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
+      const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
+      const __m128i vw = _mm_set1_epi32(w);
+      alignas(16) std::int32_t off[4];
+      for (; c + 4 <= g.cols; c += 4) {
+        const __m128 vc = _mm_setr_ps(static_cast<float>(c), static_cast<float>(c + 1),
+                                      static_cast<float>(c + 2), static_cast<float>(c + 3));
+        __m128 x = _mm_add_ps(vx0, _mm_mul_ps(vc, vax)), y = _mm_add_ps(vy0, _mm_mul_ps(vc, vay));
+        if (!inside) {
+          x = _mm_min_ps(_mm_max_ps(x, zero), vxmax);
+          y = _mm_min_ps(_mm_max_ps(y, zero), vymax);
+        }
+        const __m128i ix = _mm_cvttps_epi32(x), iy = _mm_cvttps_epi32(y);
+        const __m128 fx = _mm_sub_ps(x, _mm_cvtepi32_ps(ix)), fy = _mm_sub_ps(y, _mm_cvtepi32_ps(iy));
+        _mm_store_si128(reinterpret_cast<__m128i*>(off), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
+        __m128 v[4];
+        auto lerp = [&](int k, __m128 vfx, __m128 vfy) {
+          const float* q0 = px + off[k];
+          const float* q1 = q0 + stride;
+          const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
+          const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
+          const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
+          const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
+          v[k] = _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top)));
+        };
+        lerp(0, _mm_shuffle_ps(fx, fx, 0x00), _mm_shuffle_ps(fy, fy, 0x00));
+        lerp(1, _mm_shuffle_ps(fx, fx, 0x55), _mm_shuffle_ps(fy, fy, 0x55));
+        lerp(2, _mm_shuffle_ps(fx, fx, 0xAA), _mm_shuffle_ps(fy, fy, 0xAA));
+        lerp(3, _mm_shuffle_ps(fx, fx, 0xFF), _mm_shuffle_ps(fy, fy, 0xFF));
+        _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
+        _mm_storeu_ps(pi + base + c, v[0]);
+        _mm_storeu_ps(pr + base + c, v[1]);
+        _mm_storeu_ps(pg + base + c, v[2]);
+        _mm_storeu_ps(pt + base + c, v[3]);
+      }
+    }
+#endif
+    for (; c < g.cols; ++c) {
       float x = x0 + static_cast<float>(c) * ax, y = y0 + static_cast<float>(c) * ay;
       if (!inside) {  // uniform per window: predicted perfectly
         x = std::clamp(x, 0.0f, xmax);
         y = std::clamp(y, 0.0f, ymax);
       }
-      const int ix = static_cast<int>(x), iy = static_cast<int>(y);  // x, y >= 0: truncation floors
-      const float fx = x - static_cast<float>(ix), fy = y - static_cast<float>(iy);
-      const float* q0 = px + 4 * (static_cast<std::size_t>(iy) * w + ix);
-      const float* q1 = q0 + stride;
-#if defined(__SSE2__)
-      // All four channels of a tap in one register: lerp along x on both rows, then along y.
-      const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy);
-      const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
-      const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
-      const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
-      const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
-      alignas(16) float v[4];
-      _mm_store_ps(v, _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top))));
-#else
       float v[4];
-      for (int k = 0; k < 4; ++k) {
-        const float t = q0[k] + fx * (q0[4 + k] - q0[k]), b = q1[k] + fx * (q1[4 + k] - q1[k]);
-        v[k] = t + fy * (b - t);
-      }
-#endif
+      tap(x, y, v);
       pi[base + c] = v[0];
       pr[base + c] = v[1];
       pg[base + c] = v[2];

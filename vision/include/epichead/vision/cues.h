@@ -46,6 +46,8 @@ inline int cue_count(bool colour) { return colour ? 3 : 2; }
 // Sum over cues of C_i (intensity, colour as one 2-D cue, texture), in [0, cue_count].
 // An invalid interval contributes 0: no evidence for the edgel.
 float cue_agreement(const IntervalCues& cues, const CueReference& ref, bool colour);
+// out[j] = cue_agreement(cues[j], ref, colour) for j < n (the same values, four at a time).
+void cue_agreements(const IntervalCues* cues, int n, const CueReference& ref, bool colour, float* out);
 
 // Per-window histogram machinery: bins every pixel once, then takes interval modes.
 class CueHistograms {
@@ -67,7 +69,12 @@ class CueHistograms {
  private:
   CueOptions options_;
   int capacity_ = 0;
-  std::vector<std::uint16_t> bin_i_, bin_t_, bin_c_;  // per pixel (bin_c_: 2-D chroma bin)
+  // Per pixel, the three bins packed in one word (one load per pixel in the interval loops):
+  // bits 0..15 intensity, 16..31 the 2-D chroma bin, 32..47 texture.
+  std::vector<std::uint64_t> bins_;
+  // Per pixel the four channel values interleaved (I, R, G, T), so that the modal-bin sums of
+  // an interval add one 4-lane vector per pixel.
+  std::vector<float> values_;
   // Histogram counts, all zero between calls (cleared by revisiting the interval's pixels).
   std::vector<std::uint16_t> count_i_, count_c_, count_t_;
 };

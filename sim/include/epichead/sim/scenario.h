@@ -1,0 +1,74 @@
+#pragma once
+// A simulator scenario: which scene, how the camera moves, lighting, noise, occluders, IMU and
+// how many frames, read from a small line-based text file (format: sim/scenarios/README.md).
+#include <cstdint>
+#include <expected>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "epichead/sim/head_mount.h"
+#include "epichead/sim/imu_model.h"
+#include "epichead/sim/trajectory.h"
+
+namespace epichead::sim {
+
+enum class MotionKind { walking, wheeled, handheld };
+
+// Global light level at a time; levels between keys follow a raised-cosine blend.
+struct LightKey {
+  double t_s = 0;
+  double gain = 1;
+};
+
+// Position of an occluder (index into Scene::occluders) at a time; linear between keys, held
+// before the first and after the last. Its orientation is that of the scene's default path start.
+struct OccluderKey {
+  int occluder = 0;
+  double t_s = 0;
+  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
+};
+
+struct Scenario {
+  std::string name;          // file stem (built-in name for built-ins)
+  std::string text;          // the file's text, copied into the sequence for reproduction
+  std::string scene;         // a scene_library name
+  int frames = 0;
+  double fps = 30;
+  double first_frame_s = 0.2;  // time of frame 0 (the IMU starts at 0)
+  std::uint64_t seed = 1;
+  std::string camera_path;   // camera.yaml; empty = default_camera()
+  std::optional<double> exposure_s;  // unset: the scene's
+  std::optional<int> blur_subframes; // unset: the scene's
+  int antialias_samples = 4;         // per pixel and sub-frame
+  double noise_dn = 1.5;             // sensor noise, grey levels
+  double init_error_m = 0.01, init_error_deg = 1.0;  // init.csv perturbation of the frame-0 truth
+  std::vector<LightKey> light;       // empty: gain 1
+  std::vector<OccluderKey> occluder_keys;  // occluders without keys follow the scene's default path
+
+  MotionKind motion = MotionKind::walking;
+  WalkingParams walking;
+  WheeledParams wheeled;
+  HandheldParams handheld;
+  HeadMount mount;
+  std::optional<Eigen::Vector3d> aim_world;  // unset: the scene's view target
+  double aim_t_s = 0;                        // body pose at which the fixed head angles are aimed
+  std::optional<Eigen::Vector2d> head_deg;   // explicit fixed pan, tilt (overrides aim)
+  ImuParams imu;
+
+  double frame_time_s(int frame) const { return first_frame_s + frame / fps; }
+  double light_gain(double t_s) const;
+};
+
+// Parses scenario text; `name` (a path) prefixes messages, relative paths resolve against its
+// directory. Every error is "name:line: what".
+std::expected<Scenario, std::string> parse_scenario(const std::string& text, const std::string& name);
+std::expected<Scenario, std::string> load_scenario(const std::string& path);
+// A built-in name (mockup_walk, lampshade, box_clutter, office_pan) or a path to a .scn file.
+std::expected<Scenario, std::string> find_scenario(const std::string& name_or_path);
+const std::vector<std::string>& builtin_scenario_names();
+std::string scenarios_dir();  // sim/scenarios in the source tree
+
+}  // namespace epichead::sim

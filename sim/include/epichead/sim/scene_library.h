@@ -1,0 +1,44 @@
+#pragma once
+// The four built-in scenes. Each puts its tracked object at the world origin (world z up) and
+// says in Scene::view where a camera should look from.
+//
+//   mockup_walk  a ship-section mockup, 1.0 m wide x 0.5 m deep x 0.8 m high (origin: floor under
+//                its centre), seen from 1-1.5 m by a walking robot: grey plates of nearly equal
+//                reflectance (0.55-0.62) with faint weld seams (texture, not in the model), a T-truss
+//                (flange and web plates), three flat-bar stiffeners 3 cm apart along the bottom
+//                front; shadows on a concrete floor; lighting drift via FrameInput::illumination_gain.
+//   lampshade    a truncated cone (bottom radius 0.12 m, top 0.07 m, height 0.16 m; origin: bottom
+//                rim centre, axis +z) on a lamp over a table (z = -0.25 m) in front of photos; its
+//                model has the two rim circles and 36 facets (below the crease angle); reflectance
+//                varies along the rim and over time; a thin arm (occluder 0) sweeps past.
+//   box_clutter  a printed package of 0.20 x 0.15 x 0.10 m (origin: bottom centre) on a wooden
+//                table, photos all around.
+//   office_pan   a room corner seen from a wheeled robot: two walls and the floor, a door frame,
+//                a desk with legs; 4 m x 5 m x 2.5 m; corner at the origin, back wall y = 0, left
+//                wall x = 0, the room toward +x, -y.
+#include <expected>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "epichead/sim/scene.h"
+
+namespace epichead::sim {
+
+// The names make_scene accepts, in the order above.
+const std::vector<std::string>& scene_names();
+
+// Builds a built-in scene (model, meshes, procedural textures; photos from scenes_dir()).
+// Errors name the unknown scene (with the known ones) or the photo that could not be read.
+std::expected<Scene, std::string> make_scene(std::string_view name);
+
+// The tracked object's wire-frame of a built-in scene, as written to scenes_dir()/<name>.cao
+// (a sequence's model.cao is a copy of that file).
+std::expected<vision::CadModel, std::string> make_scene_model(std::string_view name);
+
+// Directory with the built-in assets (sim/scenes in the source tree).
+std::string scenes_dir();
+// Path of a built-in scene's CAO file: scenes_dir()/<name>.cao.
+std::string scene_model_path(std::string_view name);
+
+}  // namespace epichead::sim

@@ -1,0 +1,213 @@
+#include "epichead/sim/sequence_writer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "epichead/sim/imu_model.h"
+#include "epichead/sim/renderer.h"
+#include "epichead/sim/rig.h"
+#include "epichead/sim/scene_library.h"
+#include "epichead/vision/sequence.h"
+#include "epichead/vision/stamped_pose.h"
+#include "simulate_random.h"
+
+namespace epichead::sim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double rad2deg = 180.0 / std::numbers::pi;
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+
+// Occluder poses at a time: scenario keys when the occluder has any, else the scene's default path.
+class OccluderMotion {
+ public:
+  OccluderMotion(const Scene& scene, const Scenario& s) : scene_(scene), scenario_(s) {}
+  void poses_at(double t_s, std::vector<Eigen::Isometry3d>& out) const {
+    out.clear();
+    for (std::size_t j = 0; j < scene_.occluders.size(); ++j) {
+      const bool has_path = j < scene_.occluder_paths.size();
+      Eigen::Isometry3d pose = has_path ? occluder_pose(scene_.occluder_paths[j], t_s) : Eigen::Isometry3d::Identity();
+      const OccluderKey* prev = nullptr;
+      const OccluderKey* next = nullptr;
+      for (const OccluderKey& k : scenario_.occluder_keys) {
+        if (k.occluder != static_cast<int>(j)) continue;
+        if (k.t_s <= t_s) prev = &k;
+        else if (!next) next = &k;
+      }
+      if (prev || next) {
+        if (has_path) pose.linear() = scene_.occluder_paths[j].world_T_start.linear();
+        if (!prev) pose.translation() = next->position_world;
+        else if (!next) pose.translation() = prev->position_world;
+        else {
+          const double u = (t_s - prev->t_s) / (next->t_s - prev->t_s);
+          pose.translation() = prev->position_world + u * (next->position_world - prev->position_world);
+        }
+      }
+      out.push_back(pose);
+    }
+  }
+
+ private:
+  const Scene& scene_;
+  const Scenario& scenario_;
+};
+
+std::expected<void, std::string> prepare_dir(const std::string& out_dir) {
+  std::error_code ec;
+  if (fs::exists(out_dir, ec)) {
+    if (!fs::is_directory(out_dir, ec)) return std::unexpected(out_dir + " exists and is not a directory");
+    const bool empty = fs::is_empty(out_dir, ec);
+    if (!empty && !fs::exists(fs::path(out_dir) / "sim_truth.json"))
+      return std::unexpected(out_dir + " is not empty and not an earlier simulator output; refusing to overwrite");
+    // Old frames could outnumber the new ones; frames.csv would ignore them, but a copy would not.
+    fs::remove_all(fs::path(out_dir) / "frames", ec);
+  }
+  fs::create_directories(fs::path(out_dir) / "frames", ec);
+  if (ec) return std::unexpected("cannot create " + out_dir + "/frames: " + ec.message());
+  return {};
+}
+
+std::expected<void, std::string> write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) return std::unexpected("cannot write " + path.string());
+  return {};
+}
+
+}  // namespace
+
+std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const std::string& out_dir,
+                                                      const FrameProgress& progress) {
+  auto scene = make_scene(s.scene);
+  if (!scene) return std::unexpected(scene.error());
+  auto camera = scenario_camera(s);
+  if (!camera) return std::unexpected(camera.error());
+  if (auto ok = prepare_dir(out_dir); !ok) return std::unexpected(ok.error());
+  const fs::path dir(out_dir);
+
+  const Rig rig = Rig::from_scenario(s, scene->view.target_world, scene->world_T_obj);
+  const int subframes = s.blur_subframes.value_or(scene->blur_subframes);
+  const double exposure_s = s.exposure_s.value_or(scene->exposure_s);
+  const double t_last = s.frame_time_s(s.frames - 1);
+
+  if (auto ok = camera->save((dir / "camera.yaml").string()); !ok) return std::unexpected(ok.error());
+  std::error_code ec;
+  const std::string model_src = scene_model_path(s.scene);
+  if (fs::exists(model_src)) {
+    fs::copy_file(model_src, dir / "model.cao", fs::copy_options::overwrite_existing, ec);
+    if (ec) return std::unexpected("cannot copy " + model_src + ": " + ec.message());
+  } else if (auto ok = write_text(dir / "model.cao", vision::to_cao(scene->model)); !ok) {
+    return std::unexpected(ok.error());
+  }
+
+  // Ground truth at each frame's mid-exposure (= the frame time), and the perturbed start.
+  std::vector<vision::StampedPose> gt;
+  std::vector<vision::FrameEntry> frames;
+  gt.reserve(static_cast<std::size_t>(s.frames));
+  frames.reserve(static_cast<std::size_t>(s.frames));
+  for (int i = 0; i < s.frames; ++i) {
+    const double t = s.frame_time_s(i);
+    gt.push_back({i, t, rig.cam_T_obj(t), {}});
+    char name[32];
+    std::snprintf(name, sizeof name, "frames/%06d.png", i);
+    frames.push_back({i, t, name});
+  }
+  Random init_rng(s.seed, 31);
+  const Eigen::Vector3d dir_t = Eigen::Vector3d(init_rng.normal(), init_rng.normal(), init_rng.normal()).normalized();
+  const Eigen::Vector3d axis = Eigen::Vector3d(init_rng.normal(), init_rng.normal(), init_rng.normal()).normalized();
+  vision::StampedPose init = gt.front();
+  init.cam_T_obj.linear() = Eigen::AngleAxisd(s.init_error_deg / rad2deg, axis).toRotationMatrix() * init.cam_T_obj.linear();
+  init.cam_T_obj.translation() += s.init_error_m * dir_t;
+
+  // IMU from true time 0 (before frame 0) to a little after the last frame.
+  const ImuRun imu = simulate_imu(s.imu, s.seed, [&rig](double t) { return rig.world_T_cam(t); }, 0.0,
+                                  t_last + 0.2);
+  std::vector<vision::ImuRecord> measured, truth;
+  measured.reserve(imu.samples.size());
+  truth.reserve(imu.samples.size());
+  for (const ImuSample& x : imu.samples) {
+    truth.push_back({x.t_true_s, x.gyro_true_radps, x.accel_true_mps2});
+    if (!x.dropped) measured.push_back({x.t_device_s, x.gyro_radps, x.accel_mps2});
+  }
+
+  for (auto ok : {vision::write_pose_csv((dir / "gt.csv").string(), gt),
+                  vision::write_pose_csv((dir / "init.csv").string(), {init})}) {
+    if (!ok) return std::unexpected(ok.error());
+  }
+  for (auto ok : {vision::write_imu_csv((dir / "imu.csv").string(), measured),
+                  vision::write_imu_csv((dir / "imu_true.csv").string(), truth),
+                  vision::write_frames_csv((dir / "frames.csv").string(), frames)}) {
+    if (!ok) return std::unexpected(ok.error());
+  }
+
+  SimSummary summary;
+  summary.frames = s.frames;
+  summary.duration_s = t_last - s.frame_time_s(0);
+  summary.peak_body_rate_degps = peak_angular_rate_degps(rig.body(), s.frame_time_s(0), t_last);
+  summary.imu_samples = static_cast<int>(measured.size());
+  summary.imu_dropped = imu.dropped;
+  summary.imu_saturated = imu.saturated;
+
+  const HeadAngles head0 = rig.head_angles(s.frame_time_s(0));
+  std::ostringstream j;
+  j << "{\n  \"scenario\": \"" << s.name << "\",\n  \"scene\": \"" << s.scene << "\",\n  \"seed\": " << s.seed
+    << ",\n  \"frames\": " << s.frames << ",\n  \"fps\": " << num(s.fps) << ",\n  \"first_frame_s\": "
+    << num(s.frame_time_s(0)) << ",\n  \"exposure_s\": " << num(exposure_s) << ",\n  \"blur_subframes\": " << subframes
+    << ",\n  \"jerk\": " << num(s.walking.jerk) << ",\n  \"peak_body_rate_degps\": " << num(summary.peak_body_rate_degps)
+    << ",\n  \"head_deg\": [" << num(head0.pan_rad * rad2deg) << ", " << num(head0.tilt_rad * rad2deg) << "]"
+    << ",\n  \"imu\": {\n    \"time\": \"t_device_s = clock_offset_s + (1 + clock_drift) * t_true_s\",\n"
+    << "    \"clock_offset_s\": " << num(s.imu.clock_offset_s) << ",\n    \"clock_drift\": " << num(s.imu.clock_drift)
+    << ",\n    \"rate_hz\": " << num(s.imu.rate_hz) << ",\n    \"samples\": " << imu.samples.size()
+    << ",\n    \"dropped\": " << imu.dropped << ",\n    \"saturated\": " << imu.saturated
+    << ",\n    \"gyro_scale\": " << vec(imu.gyro_scale) << ",\n    \"accel_scale\": " << vec(imu.accel_scale)
+    << ",\n    \"gyro_bias0_radps\": " << vec(imu.gyro_bias0_radps) << ",\n    \"accel_bias0_mps2\": "
+    << vec(imu.accel_bias0_mps2) << "\n  }\n}\n";
+  if (auto ok = write_text(dir / "sim_truth.json", j.str()); !ok) return std::unexpected(ok.error());
+  if (auto ok = write_text(dir / "scenario.scn", s.text); !ok) return std::unexpected(ok.error());
+
+  // Frames last: the slow part.
+  RenderOptions options;
+  options.samples_per_subframe = s.antialias_samples;
+  options.noise_sigma_dn = s.noise_dn;
+  Renderer renderer(std::move(*scene), *camera, options);
+  const Scene& rscene = renderer.scene();
+  const OccluderMotion rocc(rscene, s);
+  std::vector<std::vector<Eigen::Isometry3d>> occ_poses(static_cast<std::size_t>(subframes));
+  std::vector<SubFrame> subs(static_cast<std::size_t>(subframes));
+  cv::Mat image;
+  const std::vector<int> png_params{cv::IMWRITE_PNG_COMPRESSION, 3};
+  for (int i = 0; i < s.frames; ++i) {
+    const double t = s.frame_time_s(i);
+    for (int k = 0; k < subframes; ++k) {
+      // Sub-frames at the centres of equal slices of the exposure, which is centred on t.
+      const double tk = t + exposure_s * ((k + 0.5) / subframes - 0.5);
+      rocc.poses_at(tk, occ_poses[static_cast<std::size_t>(k)]);
+      subs[static_cast<std::size_t>(k)] = {rig.world_T_cam(tk).pose, rscene.world_T_obj, occ_poses[static_cast<std::size_t>(k)]};
+    }
+    FrameInput input;
+    input.t_s = t;
+    input.sub_frames = subs;
+    input.illumination_gain = s.light_gain(t);
+    cv::RNG rng(Random(s.seed, 41, static_cast<std::uint64_t>(i)).next_u64() | 1);
+    renderer.render(input, rng, image);
+    const std::string path = (dir / frames[static_cast<std::size_t>(i)].file).string();
+    if (!cv::imwrite(path, image, png_params)) return std::unexpected("cannot write " + path);
+    if (progress) progress(i, s.frames);
+  }
+  return summary;
+}
+
+}  // namespace epichead::sim
