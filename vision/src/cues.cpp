@@ -103,9 +103,10 @@ CueHistograms::CueHistograms(const CueOptions& options) : options_(options) {
   options_.texture_range = std::max(options_.texture_range, 1e-3f);
   options_.edge_margin_px = std::max(options_.edge_margin_px, 0);
   const std::size_t nc = static_cast<std::size_t>(options_.chroma_bins) * options_.chroma_bins;
-  count_i_.assign(options_.intensity_bins, 0);
-  count_c_.assign(nc, 0);
-  count_t_.assign(options_.texture_bins, 0);
+  // Two interleaved copies per histogram (even and odd pixels), see interval().
+  count_i_.assign(2 * static_cast<std::size_t>(options_.intensity_bins), 0);
+  count_c_.assign(2 * nc, 0);
+  count_t_.assign(2 * static_cast<std::size_t>(options_.texture_bins), 0);
 }
 
 void CueHistograms::prepare(const LineWindow& window) {
@@ -126,7 +127,27 @@ void CueHistograms::prepare(const LineWindow& window) {
   const float top_i = ni - 0.5f, top_c = nc - 0.5f, top_t = nt - 0.5f;
   std::uint64_t* __restrict bins = bins_.data();
   auto clampf = [](float v, float hi) { v = v > 0.0f ? v : 0.0f; return v < hi ? v : hi; };
-  for (int p = 0; p < n; ++p) {
+  int p = 0;
+#if defined(__SSE4_1__)
+  {
+    // Four pixels per pass: the same clamps (max/min against 0 and the top, NaN -> 0) and
+    // truncations as the scalar loop, then the three bins packed into two 64-bit words.
+    const __m128 zero = _mm_setzero_ps(), vsi = _mm_set1_ps(si), vsc = _mm_set1_ps(sc), vst = _mm_set1_ps(st);
+    const __m128 vti = _mm_set1_ps(top_i), vtc = _mm_set1_ps(top_c), vtt = _mm_set1_ps(top_t);
+    const __m128i vnc = _mm_set1_epi32(nc);
+    auto bin4 = [&](const float* x, __m128 scale, __m128 top) {
+      return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_loadu_ps(x), scale), zero), top));
+    };
+    for (; p + 4 <= n; p += 4) {
+      const __m128i bi = bin4(I + p, vsi, vti), bt = bin4(T + p, vst, vtt);
+      const __m128i bc = _mm_add_epi32(_mm_mullo_epi32(bin4(R + p, vsc, vtc), vnc), bin4(G + p, vsc, vtc));
+      const __m128i lo = _mm_or_si128(bi, _mm_slli_epi32(bc, 16));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p), _mm_unpacklo_epi32(lo, bt));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p + 2), _mm_unpackhi_epi32(lo, bt));
+    }
+  }
+#endif
+  for (; p < n; ++p) {
     const auto bi = static_cast<std::uint32_t>(static_cast<int>(clampf(I[p] * si, top_i)));
     const auto bt = static_cast<std::uint32_t>(static_cast<int>(clampf(T[p] * st, top_t)));
     const auto bc = static_cast<std::uint32_t>(static_cast<int>(clampf(R[p] * sc, top_c)) * nc +
@@ -134,7 +155,7 @@ void CueHistograms::prepare(const LineWindow& window) {
     bins[p] = (static_cast<std::uint64_t>(bt) << 32) | (bc << 16) | bi;
   }
   float* __restrict vals = values_.data();
-  int p = 0;
+  p = 0;
 #if defined(__SSE4_1__)
   for (; p + 4 <= n; p += 4) {
     __m128 a = _mm_loadu_ps(I + p), b = _mm_loadu_ps(R + p), c = _mm_loadu_ps(G + p), d = _mm_loadu_ps(T + p);
@@ -162,7 +183,9 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   const int p0 = row * g.cols + col_begin, p1 = row * g.cols + col_end;
   // Pass 1: counts only, tracking each mode (the first bin to reach the top count wins ties).
   // Keeping sums out of this loop shortens its store-to-load chains (neighbouring pixels mostly
-  // share a bin).
+  // share a bin); two copies of each histogram, one for even and one for odd pixels (element
+  // 2 b and 2 b + 1), halve them again: a pixel's count is the sum of both copies, and the
+  // increment of one copy no longer waits for the previous pixel's store.
   const std::uint64_t* bins = bins_.data();
   int best_i = static_cast<int>(bins[p0] & 0xFFFF), best_c = static_cast<int>((bins[p0] >> 16) & 0xFFFF),
       best_t = static_cast<int>(bins[p0] >> 32);
@@ -170,33 +193,42 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   std::uint16_t* const hist_i = count_i_.data();
   std::uint16_t* const hist_c = count_c_.data();
   std::uint16_t* const hist_t = count_t_.data();
-  for (int p = p0; p < p1; ++p) {
-    const std::uint64_t q = bins[p];
+  auto step = [&](std::uint64_t q, int k) {
     const int bi = static_cast<int>(q & 0xFFFF), bc = static_cast<int>((q >> 16) & 0xFFFF), bt = static_cast<int>(q >> 32);
-    const int ci = ++hist_i[bi], cc = ++hist_c[bc], ct = ++hist_t[bt];
+    std::uint16_t* const hi = hist_i + 2 * bi;
+    std::uint16_t* const hc = hist_c + 2 * bc;
+    std::uint16_t* const ht = hist_t + 2 * bt;
+    const int ci = ++hi[k] + hi[k ^ 1], cc = ++hc[k] + hc[k ^ 1], ct = ++ht[k] + ht[k ^ 1];
     best_i = ci > top_i ? bi : best_i;
     top_i = ci > top_i ? ci : top_i;
     best_c = cc > top_c ? bc : best_c;
     top_c = cc > top_c ? cc : top_c;
     best_t = ct > top_t ? bt : best_t;
     top_t = ct > top_t ? ct : top_t;
+  };
+  int p = p0;
+  for (; p + 2 <= p1; p += 2) {
+    step(bins[p], 0);
+    step(bins[p + 1], 1);
   }
+  if (p < p1) step(bins[p], 0);
   // Pass 2: clear the touched bins and sum the samples of each modal bin (branch-free), so the
   // mode is refined to the mean of its bin (finer than the bin width).
   std::uint16_t* __restrict ci_ = count_i_.data();
   std::uint16_t* __restrict cc_ = count_c_.data();
   std::uint16_t* __restrict ct_ = count_t_.data();
   const float* vals = values_.data();
+  auto clear2 = [](std::uint16_t* h) { const std::uint32_t z = 0; std::memcpy(h, &z, sizeof z); };
 #if defined(__SSE4_1__)
   // Lanes (I, R, G, T) against the modal bins (intensity, chroma, chroma, texture); each lane
   // adds in pixel order, so the sums are those of the scalar loop.
   const __m128i best = _mm_setr_epi32(best_i, best_c, best_c, best_t);
   __m128 sum = _mm_setzero_ps();
-  for (int p = p0; p < p1; ++p) {
+  for (p = p0; p < p1; ++p) {
     const std::uint64_t q = bins[p];
-    ci_[q & 0xFFFF] = 0;
-    cc_[(q >> 16) & 0xFFFF] = 0;
-    ct_[q >> 32] = 0;
+    clear2(ci_ + 2 * (q & 0xFFFF));
+    clear2(cc_ + 2 * ((q >> 16) & 0xFFFF));
+    clear2(ct_ + 2 * (q >> 32));
     const __m128i b = _mm_shuffle_epi32(_mm_cvtepu16_epi32(_mm_cvtsi64_si128(static_cast<long long>(q))), 0x94);
     const __m128 hit = _mm_castsi128_ps(_mm_cmpeq_epi32(b, best));
     sum = _mm_add_ps(sum, _mm_and_ps(hit, _mm_loadu_ps(vals + 4 * static_cast<std::size_t>(p))));
@@ -209,9 +241,9 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   for (int p = p0; p < p1; ++p) {
     const std::uint64_t q = bins[p];
     const int bi = static_cast<int>(q & 0xFFFF), bc = static_cast<int>((q >> 16) & 0xFFFF), bt = static_cast<int>(q >> 32);
-    ci_[bi] = 0;
-    cc_[bc] = 0;
-    ct_[bt] = 0;
+    clear2(ci_ + 2 * bi);
+    clear2(cc_ + 2 * bc);
+    clear2(ct_ + 2 * bt);
     si += bi == best_i ? vals[4 * p] : 0.0f;
     sr += bc == best_c ? vals[4 * p + 1] : 0.0f;
     sg += bc == best_c ? vals[4 * p + 2] : 0.0f;
