@@ -220,19 +220,20 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   const float* vals = values_.data();
   auto clear2 = [](std::uint16_t* h) { const std::uint32_t z = 0; std::memcpy(h, &z, sizeof z); };
 #if defined(__SSE4_1__)
-  // Lanes (I, R, G, T) against the modal bins (intensity, chroma, chroma, texture); each lane
-  // adds in pixel order, so the sums are those of the scalar loop.
+  // Lanes (I, R, G, T) against the modal bins (intensity, chroma, chroma, texture).
   const __m128i best = _mm_setr_epi32(best_i, best_c, best_c, best_t);
-  __m128 sum = _mm_setzero_ps();
-  for (p = p0; p < p1; ++p) {
+  auto masked = [&](int p) {
     const std::uint64_t q = bins[p];
     clear2(ci_ + 2 * (q & 0xFFFF));
     clear2(cc_ + 2 * ((q >> 16) & 0xFFFF));
     clear2(ct_ + 2 * (q >> 32));
     const __m128i b = _mm_shuffle_epi32(_mm_cvtepu16_epi32(_mm_cvtsi64_si128(static_cast<long long>(q))), 0x94);
     const __m128 hit = _mm_castsi128_ps(_mm_cmpeq_epi32(b, best));
-    sum = _mm_add_ps(sum, _mm_and_ps(hit, _mm_loadu_ps(vals + 4 * static_cast<std::size_t>(p))));
-  }
+    return _mm_and_ps(hit, _mm_loadu_ps(vals + 4 * static_cast<std::size_t>(p)));
+  };
+  // One add chain in pixel order, so the sums are those of the scalar loop.
+  __m128 sum = _mm_setzero_ps();
+  for (p = p0; p < p1; ++p) sum = _mm_add_ps(sum, masked(p));
   alignas(16) float s4[4];
   _mm_store_ps(s4, sum);
   const float si = s4[0], sr = s4[1], sg = s4[2], st = s4[3];

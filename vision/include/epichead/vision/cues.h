@@ -75,7 +75,8 @@ class CueHistograms {
   // Per pixel the four channel values interleaved (I, R, G, T), so that the modal-bin sums of
   // an interval add one 4-lane vector per pixel.
   std::vector<float> values_;
-  // Histogram counts, all zero between calls (cleared by revisiting the interval's pixels).
+  // Histogram counts, all zero between calls (cleared by revisiting the interval's pixels); two
+  // interleaved copies (element 2 b for even pixels, 2 b + 1 for odd) break the counting chains.
   std::vector<std::uint16_t> count_i_, count_c_, count_t_;
 };
 
