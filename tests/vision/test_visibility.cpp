@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "epichead/vision/look_at.h"
 #include "epichead/vision/visibility.h"
 
 using namespace epichead::vision;
@@ -15,18 +16,9 @@ namespace {
 
 Camera test_camera(const Distortion& dist = {}) { return Camera(640, 480, {500, 500, 320, 240}, dist); }
 
-// cam_T_obj for a camera at `eye` (object frame) looking at `target`, with `up` roughly up.
-Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-                          const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ()) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(up).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Isometry3d obj_T_cam = Eigen::Isometry3d::Identity();
-  obj_T_cam.linear().col(0) = x;
-  obj_T_cam.linear().col(1) = y;
-  obj_T_cam.linear().col(2) = z;
-  obj_T_cam.translation() = eye;
-  return obj_T_cam.inverse();
+// cam_T_obj for a camera at `eye` (object frame) looking at `target`.
+Eigen::Isometry3d camera_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  return epichead::vision::look_at(eye, target).inverse();
 }
 
 CadModel make_prism(const std::vector<Eigen::Vector2d>& profile_ccw, double height) {
@@ -140,7 +132,7 @@ bool pixel_on_object(const CadModel& m, const Camera& camera, const Eigen::Isome
 TEST_CASE("cube seen from a corner shows six contour and three crease edges", "[visibility]") {
   const CadModel cube = make_cube();
   const Camera camera = test_camera();
-  const auto pose = look_at({0.5, 0.4, 0.45}, {0.05, 0.05, 0.05});
+  const auto pose = camera_at({0.5, 0.4, 0.45}, {0.05, 0.05, 0.05});
   const VisibleModel out = compute_visibility(cube, camera, pose);
   int contour = 0, crease = 0;
   for (const auto& e : out.edges) {
@@ -163,7 +155,7 @@ TEST_CASE("object side of every contour edge is where the object is in the image
     const double az = angle(rng), el = elev(rng);
     const Eigen::Vector3d eye = Eigen::Vector3d(0.05, 0.05, 0.05) +
                                 0.5 * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-    const auto pose = look_at(eye, {0.05, 0.05, 0.05});
+    const auto pose = camera_at(eye, {0.05, 0.05, 0.05});
     for (const auto& e : compute_visibility(cube, camera, pose).edges) {
       const Eigen::Vector2d mid = 0.5 * (e.a_px + e.b_px);
       const Eigen::Vector2d d = (e.b_px - e.a_px).normalized();
@@ -193,7 +185,7 @@ TEST_CASE("visible pieces agree with a ray caster on the cube and the non-convex
       const Eigen::Vector3d eye =
           centre + dist(rng) * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
       INFO(name << " trial " << trial);
-      partly_hidden += check_against_ray_caster(model, camera, look_at(eye, centre));
+      partly_hidden += check_against_ray_caster(model, camera, camera_at(eye, centre));
     }
     // The L-shape's arms hide parts of each other's edges from many directions; the cube never does.
     if (std::string(name) == "l_shape") CHECK(partly_hidden > 10);
@@ -207,7 +199,7 @@ TEST_CASE("an L-shape edge behind the other arm is clipped to its visible pieces
   // From the upper left, below the top, the upper arm (x 0..0.1, y 0.1..0.2) stands in front of
   // the lower arm's face y = 0.1 and hides the near part (x < ~0.157) of its top edge
   // (0.1, 0.1, 0.1)-(0.2, 0.1, 0.1); the rest stays visible.
-  const auto pose = look_at({-0.3, 0.9, 0.05}, {0.15, 0.05, 0.05});
+  const auto pose = camera_at({-0.3, 0.9, 0.05}, {0.15, 0.05, 0.05});
   const VisibleModel out = compute_visibility(l, camera, pose);
   int far_edge = -1;
   for (int e = 0; e < static_cast<int>(l.edges.size()); ++e) {
@@ -234,7 +226,7 @@ TEST_CASE("edges between nearly coplanar facets are dropped unless on the silhou
   for (int i = 0; i < 36; ++i) profile.emplace_back(0.1 * std::cos(i * M_PI / 18), 0.1 * std::sin(i * M_PI / 18));
   const CadModel prism = make_prism(profile, 0.3);
   const Camera camera = test_camera();
-  const auto pose = look_at({1.2, 0.3, 0.15}, {0, 0, 0.15});
+  const auto pose = camera_at({1.2, 0.3, 0.15}, {0, 0, 0.15});
   const VisibleModel out = compute_visibility(prism, camera, pose);
   int vertical_contours = 0, vertical_creases = 0;
   for (const auto& e : out.edges) {
@@ -275,7 +267,7 @@ TEST_CASE("visible pieces are clipped to the image, also with lens distortion", 
   const CadModel cube = make_cube();
   for (const Distortion& dist : {Distortion{}, Distortion{-0.3, 0.1, 0.001, -0.001, 0}}) {
     const Camera camera = test_camera(dist);
-    const auto pose = look_at({0.2, 0.12, 0.14}, {0.05, 0.05, 0.05});  // close: the cube overflows the image
+    const auto pose = camera_at({0.2, 0.12, 0.14}, {0.05, 0.05, 0.05});  // close: the cube overflows the image
     const VisibleModel out = compute_visibility(cube, camera, pose);
     CHECK_FALSE(out.edges.empty());
     for (const auto& e : out.edges) {
@@ -293,7 +285,7 @@ TEST_CASE("a projected circle is the ellipse through its projected points", "[vi
   circle.radius_m = 0.08;
   model.circles.push_back(circle);
   const Camera camera = test_camera();
-  const auto pose = look_at({0.3, -0.4, 0.5}, {0, 0, 0});
+  const auto pose = camera_at({0.3, -0.4, 0.5}, {0, 0, 0});
   const VisibleModel out = compute_visibility(model, camera, pose);
   REQUIRE(out.ellipses.size() == 1);
   const VisibleEllipse& el = out.ellipses[0];
@@ -320,7 +312,7 @@ TEST_CASE("cylinder limbs are tangent: the whole surface lies on the axis side o
   CadModel model;
   model.cylinders.push_back({{0, 0, 0}, {0, 0, 0.3}, 0.05});
   const Camera camera = test_camera();
-  const auto pose = look_at({0.6, 0.4, 0.4}, {0, 0, 0.15});
+  const auto pose = camera_at({0.6, 0.4, 0.4}, {0, 0, 0.15});
   const VisibleModel out = compute_visibility(model, camera, pose);
   REQUIRE(out.edges.size() == 2);
   for (const auto& e : out.edges) {

@@ -3,20 +3,13 @@
 #include <memory>
 
 #include "bench/bench.h"
+#include "epichead/vision/look_at.h"
 #include "epichead/vision/visibility.h"
 
 namespace {
 
 using namespace epichead::vision;
 
-Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  Eigen::Isometry3d obj_T_cam = Eigen::Isometry3d::Identity();
-  obj_T_cam.linear() << x, z.cross(x), z;
-  obj_T_cam.translation() = eye;
-  return obj_T_cam.inverse();
-}
 
 // Axis-aligned box as a closed model: 8 vertices, 6 faces CCW from outside.
 void add_box(RawModel& raw, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
@@ -57,7 +50,7 @@ const epichead::bench::Registration grid300{"visibility_300", [] {
     for (int j = 0; j < 5; ++j)
       add_box(raw, {0.12 * i, 0.12 * j, 0}, {0.12 * i + 0.08, 0.12 * j + 0.08, 0.05 + 0.02 * ((i + j) % 3)});
   b->model = *build_model(raw, "grid300");
-  b->pose = look_at({-0.5, -0.4, 0.45}, {0.26, 0.26, 0.03});
+  b->pose = look_at({-0.5, -0.4, 0.45}, {0.26, 0.26, 0.03}).inverse();
   b->visibility = std::make_unique<Visibility>(b->model, b->camera);
   return [b] { b->visibility->compute(b->pose, b->out); };
 }};

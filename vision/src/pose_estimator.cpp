@@ -144,12 +144,17 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
     return;
   }
 
-  // Visits every residual (normalised by its sigma) with its Jacobian row and feature slot.
-  // With want_jacobian false, J is left untouched (cheaper cost evaluation).
+  const std::size_t slots = problem.lines.size() + problem.points.size() + problem.ellipses.size() + problem.points_3d.size();
+  rejected_.assign(slots, 0);
+  bool visit_rejected = false;  // true while measuring every feature, rejected ones included
+  auto skip = [&](int slot) { return !visit_rejected && rejected_[slot]; };
+
+  // Visits every residual (normalised by its sigma) with its Jacobian row and feature slot,
+  // skipping rejected features. With want_jacobian false, J is left untouched.
   auto visit = [&](const Eigen::Isometry3d& pose, bool want_jacobian, auto&& fn) {
     int slot = 0;
     for (const auto& obs : problem.lines) {
-      if (obs.edgels_px.size() < 2 || rejected_[slot]) { ++slot; continue; }
+      if (obs.edgels_px.size() < 2 || skip(slot)) { ++slot; continue; }
       const Eigen::Vector3d A = pose * obs.a_obj, B = pose * obs.b_obj;
       const Eigen::Vector3d l = A.cross(B);
       const double s = std::hypot(l.x(), l.y());
@@ -170,7 +175,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       ++slot;
     }
     for (const auto& obs : problem.points) {
-      if (rejected_[slot]) { ++slot; continue; }
+      if (skip(slot)) { ++slot; continue; }
       const Eigen::Vector3d X = pose * obs.p_obj;
       const Eigen::Vector2d xn(X.x() / X.z(), X.y() / X.z());
       const Eigen::Vector2d r = (camera_.normalized_to_pixel(xn) - obs.px) / obs.sigma_px;
@@ -185,7 +190,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       ++slot;
     }
     for (const auto& obs : problem.ellipses) {
-      if (obs.points_px.size() < 5 || rejected_[slot]) { ++slot; continue; }
+      if (obs.points_px.size() < 5 || skip(slot)) { ++slot; continue; }
       // Numerical Jacobian: six perturbed conics per ellipse, shared by all its points.
       const Eigen::Matrix3d C = circle_conic_normalized(obs.circle, pose);
       Eigen::Matrix3d Cd[6];
@@ -208,7 +213,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       ++slot;
     }
     for (const auto& obs : problem.points_3d) {
-      if (rejected_[slot]) { ++slot; continue; }
+      if (skip(slot)) { ++slot; continue; }
       const Eigen::Vector3d X = pose * obs.p_obj;
       const Eigen::Vector3d r = (X - obs.p_cam) / obs.sigma_m;
       Eigen::Matrix<double, 3, 6> J3;
@@ -231,18 +236,15 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
     return std::max(options_.min_scale_px, 1.4826 * median_in_place(residual_scratch_));
   };
 
-  const std::size_t slots = problem.lines.size() + problem.points.size() + problem.ellipses.size() + problem.points_3d.size();
-  rejected_.assign(slots, 0);
   feature_sq_.assign(slots, 0.0);
   feature_n_.assign(slots, 0.0);
   // Per-feature normalised RMS at `pose` over every feature (rejected ones too).
   auto feature_rms = [&](const Eigen::Isometry3d& pose) {
     std::fill(feature_sq_.begin(), feature_sq_.end(), 0.0);
     std::fill(feature_n_.begin(), feature_n_.end(), 0.0);
-    std::swap(rejected_, rejected_spare_);
-    rejected_.assign(slots, 0);
+    visit_rejected = true;
     visit(pose, false, [&](double r, const RowJ&, int slot) { feature_sq_[slot] += r * r; feature_n_[slot] += 1; });
-    std::swap(rejected_, rejected_spare_);
+    visit_rejected = false;
     for (std::size_t i = 0; i < slots; ++i) feature_sq_[i] = feature_n_[i] > 0 ? std::sqrt(feature_sq_[i] / feature_n_[i]) : 0;
   };
 

@@ -180,9 +180,9 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
     }
     std::sort(hidden_.begin(), hidden_.end());
 
-    const Eigen::Vector2d probe = normalized(side_probe_cam);
-    ObjectSide side = ObjectSide::Both;
-    if (side_from_probe) side = side_of(normalized(A + 0.5 * (lo + hi) * D - 1e-3 * D), normalized(A + 0.5 * (lo + hi) * D + 1e-3 * D), probe);
+    // A 3D segment projects to a straight one in normalised coordinates: its clipped ends give
+    // the direction the side is measured against.
+    const ObjectSide side = side_from_probe ? side_of(n0, n1, normalized(side_probe_cam)) : ObjectSide::Both;
 
     auto push_piece = [&](double s0, double s1) {
       const Eigen::Vector3d a_cam = A + s0 * D, b_cam = A + s1 * D;

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "epichead/vision/cao_model.h"
+#include "epichead/vision/look_at.h"
 
 namespace epichead::sim {
 
@@ -126,10 +127,8 @@ struct OccluderPath {
 // The pose of an occluder on its default path at time t_s (translation linear, rotation slerp).
 Eigen::Isometry3d occluder_pose(const OccluderPath& path, double t_s);
 
-// world_T_cam for a camera at `camera_world` looking at `target_world`, image up as close to
-// `up_world` as possible (camera frame: x right, y down, z forward).
-Eigen::Isometry3d look_at(const Eigen::Vector3d& camera_world, const Eigen::Vector3d& target_world,
-                          const Eigen::Vector3d& up_world = Eigen::Vector3d::UnitZ());
+// Camera placement is vision's (sim code and its users call it as sim::look_at too).
+using vision::look_at;
 
 struct Scene {
   std::string name;

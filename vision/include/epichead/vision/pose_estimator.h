@@ -103,7 +103,7 @@ class PoseEstimator {
   Camera camera_;
   PoseOptions options_;
   std::vector<double> residual_scratch_;  // |r| of every residual, for the robust scale
-  std::vector<unsigned char> rejected_, rejected_spare_;  // per feature slot
+  std::vector<unsigned char> rejected_;                    // per feature slot
   std::vector<double> feature_sq_, feature_n_;            // per feature slot: RMS, residual count
 };
 
