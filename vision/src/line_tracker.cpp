@@ -18,6 +18,15 @@ void LineTracker::reset() {
 }
 
 void LineTracker::track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
+  detect(image, visible, placement);
+  for (LineFeature& f : features_) {
+    if (!f.visible) continue;
+    if (f.result.found()) accept(f.edge, 0);
+    else reject(f.edge);
+  }
+}
+
+void LineTracker::detect(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
   int max_edge = -1;
   for (const VisibleEdge& e : visible.edges) max_edge = std::max(max_edge, e.edge);
   if (max_edge >= static_cast<int>(features_.size())) {  // first frame (warm-up)
@@ -38,16 +47,17 @@ void LineTracker::track(const WindowImage& image, const VisibleModel& visible, W
     f.visible = f.found = false;
     f.selected = -1;
     if (longest_[k] < 0) { f.has_previous = false; continue; }  // hidden: re-project when it returns
-    track_one(image, visible.edges[longest_[k]], placement, f);
+    detect_one(image, visible.edges[longest_[k]], placement, f);
   }
 }
 
-void LineTracker::track_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f) {
+void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f) {
   if (!f.reserved) {
     f.result.reserve(options_.window, options_.epic.ransac);
     f.reserved = true;
   }
   f.side = piece.side;
+  f.piece = piece;
   if (!f.refs.initialised && options_.mode != EpicMode::Gradient) {
     // References from the object side of the projected edge, whatever the placement.
     if (window_.sample(image, piece.a_px, piece.b_px)) detector_.init_references(window_, piece.side, f.refs);
@@ -68,20 +78,35 @@ void LineTracker::track_one(const WindowImage& image, const VisibleEdge& piece, 
   }
   f.visible = true;
   detector_.detect(window_, piece.side, f.refs, options_.mode, f.result);
+  // Candidates are sorted by support: drop the tail too weak to be a line of this window.
   const int rows = window_.geometry().rows;
   const int need = std::max(options_.epic.ransac.min_support,
                             static_cast<int>(std::ceil(options_.min_support_ratio * static_cast<float>(rows))));
-  if (f.result.found() && f.result.candidates.front().support >= need) {
-    const LineCandidate& c = f.result.candidates.front();
-    f.found = true;
-    f.selected = 0;
-    f.has_previous = true;
-    f.previous_a_px = c.a_px;
-    f.previous_b_px = c.b_px;
-    if (options_.mode != EpicMode::Gradient) detector_.update_references(f.result, c, piece.side, f.refs);
-  } else {
-    f.has_previous = false;  // lost: the next window goes back to the projection (recovery)
+  auto& cands = f.result.candidates;
+  while (!cands.empty() && cands.back().support < need) cands.pop_back();
+  if (!cands.empty()) f.selected = 0;
+}
+
+void LineTracker::accept(int edge, int candidate) {
+  LineFeature& f = features_[static_cast<std::size_t>(edge)];
+  if (!f.visible || candidate < 0 || candidate >= static_cast<int>(f.result.candidates.size())) {
+    reject(edge);
+    return;
   }
+  const LineCandidate& c = f.result.candidates[static_cast<std::size_t>(candidate)];
+  f.found = true;
+  f.selected = candidate;
+  f.has_previous = true;
+  f.previous_a_px = c.a_px;
+  f.previous_b_px = c.b_px;
+  if (options_.mode != EpicMode::Gradient) detector_.update_references(f.result, c, f.side, f.refs);
+}
+
+void LineTracker::reject(int edge) {
+  LineFeature& f = features_[static_cast<std::size_t>(edge)];
+  f.found = false;
+  f.selected = -1;
+  f.has_previous = false;  // lost: the next window goes back to the projection (recovery)
 }
 
 }  // namespace epichead::vision

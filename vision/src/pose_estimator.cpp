@@ -145,6 +145,18 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   }
 
   const std::size_t slots = problem.lines.size() + problem.points.size() + problem.ellipses.size() + problem.points_3d.size();
+  // Undistort every edgel and ellipse point once: the residuals are visited several times per
+  // iteration, and undistortion is iterative.
+  normalized_.clear();
+  offsets_.clear();
+  for (const auto& obs : problem.lines) {
+    offsets_.push_back(normalized_.size());
+    for (const auto& q : obs.edgels_px) normalized_.push_back(camera_.pixel_to_normalized(q));
+  }
+  for (const auto& obs : problem.ellipses) {
+    offsets_.push_back(normalized_.size());
+    for (const auto& q : obs.points_px) normalized_.push_back(camera_.pixel_to_normalized(q));
+  }
   rejected_.assign(slots, 0);
   bool visit_rejected = false;  // true while measuring every feature, rejected ones included
   auto skip = [&](int slot) { return !visit_rejected && rejected_[slot]; };
@@ -153,16 +165,17 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   // skipping rejected features. With want_jacobian false, J is left untouched.
   auto visit = [&](const Eigen::Isometry3d& pose, bool want_jacobian, auto&& fn) {
     int slot = 0;
+    std::size_t list = 0;  // index into offsets_: lines, then ellipses
     for (const auto& obs : problem.lines) {
+      const Eigen::Vector2d* xns = normalized_.data() + offsets_[list++];
       if (obs.edgels_px.size() < 2 || skip(slot)) { ++slot; continue; }
       const Eigen::Vector3d A = pose * obs.a_obj, B = pose * obs.b_obj;
       const Eigen::Vector3d l = A.cross(B);
       const double s = std::hypot(l.x(), l.y());
       Eigen::Matrix<double, 3, 6> dl = Eigen::Matrix<double, 3, 6>::Zero();
       if (want_jacobian) dl = -skew(B) * point_jacobian(A) + skew(A) * point_jacobian(B);
-      for (const auto& q : obs.edgels_px) {
-        const Eigen::Vector2d xn = camera_.pixel_to_normalized(q);
-        const Eigen::Vector3d x(xn.x(), xn.y(), 1);
+      for (std::size_t k = 0; k < obs.edgels_px.size(); ++k) {
+        const Eigen::Vector3d x(xns[k].x(), xns[k].y(), 1);
         const double ldx = l.dot(x);
         const double r = focal * ldx / s / obs.sigma_px;
         RowJ J;
@@ -190,6 +203,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       ++slot;
     }
     for (const auto& obs : problem.ellipses) {
+      const Eigen::Vector2d* xns = normalized_.data() + offsets_[list++];
       if (obs.points_px.size() < 5 || skip(slot)) { ++slot; continue; }
       // Numerical Jacobian: six perturbed conics per ellipse, shared by all its points.
       const Eigen::Matrix3d C = circle_conic_normalized(obs.circle, pose);
@@ -202,8 +216,8 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
           Cd[k] = circle_conic_normalized(obs.circle, apply_left(xi, pose));
         }
       }
-      for (const auto& q : obs.points_px) {
-        const Eigen::Vector2d xn = camera_.pixel_to_normalized(q);
+      for (std::size_t k = 0; k < obs.points_px.size(); ++k) {
+        const Eigen::Vector2d& xn = xns[k];
         const double r = focal * conic_distance(C, xn) / obs.sigma_px;
         RowJ J;
         if (want_jacobian)

@@ -2,6 +2,11 @@
 // Per-frame line tracking: one EPIC window per visible model edge, per-feature cue references
 // kept across frames, and the selected line of each feature. Allocation-free after warm-up
 // (each feature's buffers are reserved the first time it is seen).
+//
+// Two ways to use it: track() detects and takes each window's best candidate at once (line
+// tracking on its own); detect() followed by accept()/reject() per feature lets a later step
+// (topology validation, the pose's outlier test) choose the candidate before the feature's cue
+// references learn from it.
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,9 +39,12 @@ struct LineFeature {
   int edge = -1;                 // index into CadModel::edges
   bool visible = false;          // a window was placed this frame
   bool found = false;            // a candidate was selected this frame
+  VisibleEdge piece;             // the projected piece the window was derived from (when visible)
   ObjectSide side = ObjectSide::Both;
   Eigen::Vector2d window_a_px = Eigen::Vector2d::Zero(), window_b_px = Eigen::Vector2d::Zero();  // window placed on a->b
   int selected = -1;             // index into result.candidates, -1 when not found
+  // Candidates are only those with at least min_support_ratio of the rows as inliers (detect()
+  // drops the rest), so every candidate is a plausible line.
   EpicResult result;
   FeatureReferences refs;
   bool has_previous = false;     // previous_a/b hold last frame's selected line
@@ -54,13 +62,23 @@ class LineTracker {
   // projection and the ObjectSide); references are initialised from the projection the first
   // time an edge is seen and updated from every selected candidate (not in gradient mode).
   void track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement);
+  // Places the windows and runs EPIC like track(), but selects nothing and learns nothing:
+  // features with candidates have selected = 0 and found = false until accept() or reject().
+  void detect(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement);
+  // Selects candidate `candidate` of feature `edge`: it becomes the feature's previous line and
+  // its inlier edgels update the cue references (except in gradient mode).
+  void accept(int edge, int candidate);
+  // The feature found nothing usable this frame: its next window returns to the projection.
+  void reject(int edge);
   // Indexed by model edge; only entries with visible == true were processed this frame.
   const std::vector<LineFeature>& features() const { return features_; }
+  // Detection window of the tracker, for other steps that sample the same image.
+  const WindowOptions& window_options() const { return options_.window; }
   // Forgets all references and previous results.
   void reset();
 
  private:
-  void track_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f);
+  void detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f);
   LineTrackerOptions options_;
   LineWindow window_;
   EpicDetector detector_;

@@ -105,6 +105,8 @@ class PoseEstimator {
   std::vector<double> residual_scratch_;  // |r| of every residual, for the robust scale
   std::vector<unsigned char> rejected_;                    // per feature slot
   std::vector<double> feature_sq_, feature_n_;            // per feature slot: RMS, residual count
+  std::vector<Eigen::Vector2d> normalized_;               // undistorted edgels and ellipse points
+  std::vector<std::size_t> offsets_;                      // per line, then per ellipse: start in normalized_
 };
 
 // SE(3) exponential of (translation, rotation) applied on the left: exp(xi) * pose.

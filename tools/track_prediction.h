@@ -1,0 +1,31 @@
+#pragma once
+// Where `epichead track` places each frame's windows: the pose predicted at the frame's time,
+// from the IMU (--imu on) or from a constant-velocity model of the tracked poses (--imu off).
+// After a loss the prediction restarts from the last good pose.
+#include <expected>
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "epichead/vision/model_tracker.h"
+#include "epichead/vision/sequence.h"
+
+namespace epichead::tools {
+
+class TrackPredictor {
+ public:
+  virtual ~TrackPredictor() = default;
+  // Predicted cam_T_obj at camera time t_s (after the first observe()).
+  virtual Eigen::Isometry3d predict(double t_s) = 0;
+  // The tracker's result for the frame exposed at t_s.
+  virtual void observe(double t_s, const vision::FrameReport& report) = 0;
+  // Counters for report.json.
+  virtual nlohmann::json diagnostics() const = 0;
+};
+
+// --imu on needs the sequence's imu.csv; the error says so when it is missing.
+std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu);
+
+}  // namespace epichead::tools

@@ -1,0 +1,134 @@
+#pragma once
+// The per-frame model-based tracker (DESIGN.md steps 1-6): visibility at the predicted pose ->
+// line windows (EPIC) -> RANSAC candidates -> topology validation -> robust pose -> cue
+// reference update of the features the pose accepted. The caller supplies the prediction (the
+// Kalman predictor, a constant-velocity model, or the last pose) and gets the pose, its
+// covariance, a status with reasons, per-stage timings and feature counts. After warm-up (the
+// first frames, while buffers grow to their working size) a frame allocates nothing.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "epichead/vision/camera.h"
+#include "epichead/vision/cao_model.h"
+#include "epichead/vision/line_tracker.h"
+#include "epichead/vision/pose_estimator.h"
+#include "epichead/vision/topology_validator.h"
+#include "epichead/vision/visibility.h"
+#include "epichead/vision/window_image.h"
+
+namespace epichead::vision {
+
+// What selects each feature's line (for measuring the gain of each step).
+enum class TrackMode {
+  Gradient,        // nearest strong gradient per row, no cues, no validation
+  Epic,            // EPIC cues, the best RANSAC candidate
+  EpicValidation,  // EPIC cues, several candidates, topology validation selects
+};
+const char* to_string(TrackMode mode);
+
+enum class TrackStatus { Tracked, Degraded, Lost };
+const char* to_string(TrackStatus status);
+
+// Why a frame is not simply "tracked" (bits; several may be set).
+enum class TrackReason : std::uint32_t {
+  None = 0,
+  NotVisible = 1u << 0,      // the model projects to (almost) nothing at the prediction
+  FewFeatures = 1u << 1,     // fewer than min_features lines found
+  PoseFailed = 1u << 2,      // the estimator reported too few features, degeneracy or divergence
+  FewInliers = 1u << 3,      // the pose explains less than min_inlier_ratio of the found lines
+  HighResidual = 1u << 4,    // robust residual scale above max_scale_px
+  Jump = 1u << 5,            // the pose moved implausibly far from the prediction
+  Reacquired = 1u << 6,      // tracked again after a loss (informational)
+};
+constexpr TrackReason operator|(TrackReason a, TrackReason b) {
+  return static_cast<TrackReason>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
+}
+constexpr bool has(TrackReason set, TrackReason r) {
+  return (static_cast<std::uint32_t>(set) & static_cast<std::uint32_t>(r)) != 0;
+}
+// "few_features+pose_failed", or "" for None.
+std::string to_string(TrackReason reasons);
+
+struct ModelTrackerOptions {
+  TrackMode mode = TrackMode::EpicValidation;
+  LineTrackerOptions lines;
+  ValidationOptions validation;
+  PoseOptions pose;
+  VisibilityOptions visibility;
+  int min_features = 4;            // lines needed for a pose (three fix it; one spare against a bad one)
+  double min_inlier_ratio = 0.5;   // below this share of found lines explained: degraded
+  double max_scale_px = 2.5;       // robust residual scale above this: degraded (blur, partial fits);
+                                   // above twice this the pose explains nothing: lost
+  double max_jump_px = 60.0;       // mean model-vertex motion from the prediction above this: lost
+  bool use_junctions = true;       // junction points from validation enter the pose (validation mode)
+  // Edgels per line given to the pose, evenly spread over the line's inliers. A line has two
+  // degrees of freedom; beyond ~10 edgels more only cost time (the errors of neighbouring
+  // edgels of one blurred edge are correlated, so they add little information either).
+  int max_edgels_per_line = 10;
+};
+
+// Per-stage wall time of one frame, milliseconds.
+struct StageTimes {
+  double visibility_ms = 0, epic_ms = 0, validation_ms = 0, pose_ms = 0, total_ms = 0;
+};
+
+struct FrameReport {
+  TrackStatus status = TrackStatus::Lost;
+  TrackReason reasons = TrackReason::None;
+  Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();  // the estimate (the prediction when lost)
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();  // left perturbation (t, r)
+  PoseStatus pose_status = PoseStatus::Ok;
+  double scale_px = 0;             // robust residual scale of the pose
+  int visible = 0;                 // line windows placed
+  int found = 0;                   // windows with at least one candidate
+  int validated_changed = 0;       // features where validation chose another than RANSAC's best
+  int junctions = 0;               // junction points given to the pose
+  int inliers = 0, rejected = 0;   // found lines the pose kept / rejected as outliers
+  int recovered = 0;               // lines found and kept that were lost or rejected last frame
+  int combinations = 0;            // candidate combinations validation examined
+  StageTimes times;
+};
+
+class ModelTracker {
+ public:
+  ModelTracker(const CadModel& model, const Camera& camera, const ModelTrackerOptions& options = {});
+  const ModelTrackerOptions& options() const { return options_; }
+
+  // Tracks one frame from the predicted pose (the init pose on the first frame). `out` is
+  // reused between frames.
+  void track(const WindowImage& image, const Eigen::Isometry3d& predicted_cam_T_obj, FrameReport& out);
+  // Forgets every feature's references and history (re-initialisation).
+  void reset();
+
+  // Inspection (for overlays and tests): the line features of the last frame, the validation
+  // result and the pose result.
+  const LineTracker& lines() const { return lines_; }
+  const ValidationResult& validation() const { return validation_; }
+  const PoseResult& pose() const { return pose_; }
+  const VisibleModel& visible() const { return visible_; }
+
+ private:
+  void build_problem();
+  const CadModel* model_;
+  Camera camera_;
+  ModelTrackerOptions options_;
+  Visibility visibility_;
+  LineTracker lines_;
+  TopologyValidator validator_;
+  PoseEstimator estimator_;
+  VisibleModel visible_;
+  ValidationResult validation_;
+  PoseProblem problem_;
+  PoseResult pose_;
+  std::vector<int> line_slot_;                // per model edge: its slot in problem_.lines
+  std::vector<unsigned char> kept_last_;      // per model edge: found and kept by the pose last frame
+  std::vector<unsigned char> kept_now_;
+  bool was_lost_ = false;
+  bool first_frame_ = true;
+};
+
+}  // namespace epichead::vision

@@ -1,0 +1,241 @@
+#include "epichead/vision/model_tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace epichead::vision {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+LineTrackerOptions line_options(const ModelTrackerOptions& o) {
+  LineTrackerOptions l = o.lines;
+  switch (o.mode) {
+    case TrackMode::Gradient: l.mode = EpicMode::Gradient; break;
+    case TrackMode::Epic: l.mode = EpicMode::EpicSingle; break;
+    case TrackMode::EpicValidation: l.mode = EpicMode::Epic; break;
+  }
+  return l;
+}
+
+// Line-feature states kept across frames, for counting recoveries.
+enum : unsigned char { kNotVisible = 0, kMissed = 1, kKept = 2 };
+
+}  // namespace
+
+const char* to_string(TrackMode mode) {
+  switch (mode) {
+    case TrackMode::Gradient: return "gradient";
+    case TrackMode::Epic: return "epic";
+    case TrackMode::EpicValidation: return "epic+validation";
+  }
+  return "unknown";
+}
+
+const char* to_string(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::Tracked: return "tracked";
+    case TrackStatus::Degraded: return "degraded";
+    case TrackStatus::Lost: return "lost";
+  }
+  return "unknown";
+}
+
+std::string to_string(TrackReason reasons) {
+  static constexpr std::pair<TrackReason, const char*> names[] = {
+      {TrackReason::NotVisible, "not_visible"}, {TrackReason::FewFeatures, "few_features"},
+      {TrackReason::PoseFailed, "pose_failed"}, {TrackReason::FewInliers, "few_inliers"},
+      {TrackReason::HighResidual, "high_residual"}, {TrackReason::Jump, "jump"},
+      {TrackReason::Reacquired, "reacquired"}};
+  std::string s;
+  for (const auto& [bit, name] : names) {
+    if (!has(reasons, bit)) continue;
+    if (!s.empty()) s += '+';
+    s += name;
+  }
+  return s;
+}
+
+ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const ModelTrackerOptions& options)
+    : model_(&model),
+      camera_(camera),
+      options_(options),
+      visibility_(model, camera, options.visibility),
+      lines_(line_options(options)),
+      validator_(model, options.validation),
+      estimator_(camera, options.pose) {
+  const std::size_t edges = model.edges.size();
+  // One pose-problem slot per model edge, kept for the tracker's life: a slot's edgel buffer
+  // keeps its capacity, and unused slots (no edgels) are ignored by the estimator.
+  problem_.lines.resize(edges);
+  for (std::size_t e = 0; e < edges; ++e) {
+    LineObservation& obs = problem_.lines[e];
+    obs.feature = static_cast<int>(e);
+    obs.a_obj = model.vertices[static_cast<std::size_t>(model.edges[e].v0)];
+    obs.b_obj = model.vertices[static_cast<std::size_t>(model.edges[e].v1)];
+    obs.edgels_px.reserve(static_cast<std::size_t>(options.lines.window.max_rows) * 4);
+  }
+  problem_.points.reserve(model.vertices.size());
+  kept_last_.assign(edges, kNotVisible);
+  kept_now_.assign(edges, kNotVisible);
+}
+
+void ModelTracker::reset() {
+  lines_.reset();
+  std::fill(kept_last_.begin(), kept_last_.end(), kNotVisible);
+  was_lost_ = false;
+  first_frame_ = true;
+}
+
+void ModelTracker::build_problem() {
+  const auto& features = lines_.features();
+  const bool validated = options_.mode == TrackMode::EpicValidation;
+  for (std::size_t e = 0; e < problem_.lines.size(); ++e) {
+    LineObservation& obs = problem_.lines[e];
+    obs.edgels_px.clear();
+    if (e >= features.size()) continue;
+    const LineFeature& f = features[e];
+    const int chosen = validated ? validation_.selected[e] : f.selected;
+    if (!f.visible || chosen < 0) continue;
+    const LineCandidate& c = f.result.candidates[static_cast<std::size_t>(chosen)];
+    const WindowGeometry& g = f.result.geometry;
+    const int n = std::min(c.support, std::max(2, options_.max_edgels_per_line));
+    for (int i = 0; i < n; ++i) {
+      const int k = n > 1 ? static_cast<int>((static_cast<long>(i) * (c.support - 1)) / (n - 1)) : 0;
+      const Edgel& edgel = f.result.edgels.edgels[static_cast<std::size_t>(f.result.inliers[static_cast<std::size_t>(c.inlier_begin + k)])];
+      obs.edgels_px.push_back(g.to_image(edgel.x_px, edgel.s_px));
+    }
+  }
+  problem_.points.clear();
+  if (validated && options_.use_junctions) {
+    for (const ValidatedJunction& j : validation_.junctions) {
+      PointObservation p;
+      p.feature = j.vertex;
+      p.p_obj = model_->vertices[static_cast<std::size_t>(j.vertex)];
+      p.px = j.px;
+      // A junction from more intersections is better located; sigma about one edgel's.
+      p.sigma_px = 1.5 / std::sqrt(static_cast<double>(j.lines));
+      problem_.points.push_back(p);
+    }
+  }
+}
+
+void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
+  const auto t_start = Clock::now();
+  out = FrameReport{};
+  out.cam_T_obj = predicted;
+
+  auto t = Clock::now();
+  visibility_.compute(predicted, visible_);
+  out.times.visibility_ms = ms_since(t);
+
+  t = Clock::now();
+  lines_.detect(image, visible_, WindowPlacement::Projection);
+  out.times.epic_ms = ms_since(t);
+  const auto& features = lines_.features();
+  for (const LineFeature& f : features) {
+    out.visible += f.visible;
+    out.found += f.visible && f.selected >= 0;
+  }
+
+  t = Clock::now();
+  if (options_.mode == TrackMode::EpicValidation) {
+    validator_.validate(image, features, validation_);
+    out.validated_changed = validation_.changed;
+    out.combinations = validation_.combinations;
+  }
+  out.times.validation_ms = ms_since(t);
+
+  t = Clock::now();
+  build_problem();
+  out.junctions = static_cast<int>(problem_.points.size());
+  std::fill(kept_now_.begin(), kept_now_.end(), kNotVisible);
+  for (const LineFeature& f : features)
+    if (f.visible && static_cast<std::size_t>(f.edge) < kept_now_.size()) kept_now_[static_cast<std::size_t>(f.edge)] = kMissed;
+
+  TrackReason reasons = TrackReason::None;
+  if (out.visible < 3) reasons = reasons | TrackReason::NotVisible;
+  if (out.found < options_.min_features) reasons = reasons | TrackReason::FewFeatures;
+  bool pose_ok = reasons == TrackReason::None;
+  if (pose_ok) {
+    estimator_.estimate(problem_, predicted, pose_);
+    out.pose_status = pose_.status;
+    if (pose_.status != PoseStatus::Ok) {
+      reasons = reasons | TrackReason::PoseFailed;
+      pose_ok = false;
+    }
+  }
+  if (pose_ok) {
+    // Plausibility: how far the visible model moved in the image from the prediction.
+    double moved = 0;
+    int n = 0;
+    for (const VisibleEdge& e : visible_.edges) {
+      for (const Eigen::Vector3d* p : {&e.a_obj, &e.b_obj}) {
+        const Eigen::Vector3d q = pose_.cam_T_obj * *p;
+        if (!(q.z() > 0)) { moved = 1e9; continue; }
+        moved += (camera_.project(q) - camera_.project(predicted * *p)).norm();
+        ++n;
+      }
+    }
+    if (n > 0 && moved / n > options_.max_jump_px) {
+      reasons = reasons | TrackReason::Jump;
+      pose_ok = false;
+    }
+  }
+  if (pose_ok) {
+    for (const FeatureResidual& r : pose_.residuals) {
+      // Line slots carry the model edge as feature id; points follow them.
+      if (&r - pose_.residuals.data() >= static_cast<std::ptrdiff_t>(problem_.lines.size())) break;
+      if (problem_.lines[static_cast<std::size_t>(r.feature)].edgels_px.size() < 2) continue;
+      if (r.inlier) { ++out.inliers; kept_now_[static_cast<std::size_t>(r.feature)] = kKept; }
+      else ++out.rejected;
+    }
+    out.cam_T_obj = pose_.cam_T_obj;
+    out.covariance = pose_.covariance;
+    out.scale_px = pose_.scale_px;
+    if (out.inliers < 3) {
+      reasons = reasons | TrackReason::FewInliers;
+      pose_ok = false;
+    } else if (out.inliers < options_.min_inlier_ratio * out.found) {
+      reasons = reasons | TrackReason::FewInliers;
+    }
+    if (pose_ok && pose_.scale_px > options_.max_scale_px) {
+      reasons = reasons | TrackReason::HighResidual;
+      if (pose_.scale_px > 2 * options_.max_scale_px) pose_ok = false;
+    }
+  }
+  out.times.pose_ms = ms_since(t);
+
+  if (!pose_ok) {
+    out.status = TrackStatus::Lost;
+    out.cam_T_obj = predicted;
+    for (const LineFeature& f : features)
+      if (f.visible) lines_.reject(f.edge);
+    std::fill(kept_now_.begin(), kept_now_.end(), kNotVisible);
+  } else {
+    out.status = reasons == TrackReason::None ? TrackStatus::Tracked : TrackStatus::Degraded;
+    if (was_lost_) reasons = reasons | TrackReason::Reacquired;
+    // Only lines the pose explains teach their cue references; the rest start over from the
+    // projection next frame (recovery).
+    const bool validated = options_.mode == TrackMode::EpicValidation;
+    for (const LineFeature& f : features) {
+      if (!f.visible) continue;
+      const std::size_t e = static_cast<std::size_t>(f.edge);
+      if (kept_now_[e] == kKept) {
+        lines_.accept(f.edge, validated ? validation_.selected[e] : f.selected);
+        out.recovered += kept_last_[e] == kMissed;
+      } else {
+        lines_.reject(f.edge);
+      }
+    }
+  }
+  out.reasons = reasons;
+  was_lost_ = out.status == TrackStatus::Lost;
+  first_frame_ = false;
+  std::swap(kept_last_, kept_now_);
+  out.times.total_ms = ms_since(t_start);
+}
+
+}  // namespace epichead::vision
