@@ -1,6 +1,7 @@
-// `epichead score SEQ POSES.csv [--json] [--sym-axis X,Y,Z] [--per-frame FILE.csv]`: scores a
-// tracker's poses against the sequence's gt.csv (rotation, translation and reprojection errors,
-// 5 cm / 5 degree success, losses).
+// `epichead score SEQ POSES.csv [--json] [--sym-axis X,Y,Z] [--per-frame FILE.csv]
+//  [--reference REF.csv] [--corners FRAME:FILE]...`: scores a tracker's poses against the
+// sequence's gt.csv or another tracker's poses (rotation, translation and reprojection errors,
+// 5 cm / 5 degree success, losses), and against hand-read corners of single frames (real video).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -96,6 +97,8 @@ const CommandRegistration registration{
       auto json = std::make_shared<bool>(false);
       auto axis_text = std::make_shared<std::string>();
       auto per_frame = std::make_shared<std::string>();
+      auto reference = std::make_shared<std::string>();
+      auto corners = std::make_shared<std::vector<std::string>>();
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
@@ -106,6 +109,11 @@ const CommandRegistration registration{
                      "the unobservable turn about it is removed before scoring");
       app.add_option("--per-frame", *per_frame,
                      "Write frame,present,success,rotation_deg,translation_mm,reprojection_px to this CSV");
+      app.add_option("--reference", *reference,
+                     "Compare with these poses instead of gt.csv (e.g. another tracker's reference_visp.csv)");
+      app.add_option("--corners", *corners,
+                     "FRAME:FILE: hand-read corners (X Y Z u v per line) of one frame; reports the distance of the "
+                     "projected model points (repeatable)");
       return [=]() -> int {
         std::optional<Eigen::Vector3d> axis;
         if (!axis_text->empty()) {
@@ -115,15 +123,62 @@ const CommandRegistration registration{
         }
         auto seq = vision::Sequence::open(*seq_dir);
         if (!seq) return fail("score", seq.error());
-        if (!seq->has_ground_truth())
-          return fail("score", *seq_dir + " has no gt.csv (no ground truth to score against)");
         auto estimates = vision::read_pose_csv(*poses_path);
         if (!estimates) return fail("score", estimates.error());
 
+        // Hand-read corners of single frames.
+        nlohmann::json corner_json = nlohmann::json::array();
+        for (const std::string& spec : *corners) {
+          const auto colon = spec.find(':');
+          int frame = -1;
+          try {
+            std::size_t used = 0;
+            frame = colon == std::string::npos ? -1 : std::stoi(spec.substr(0, colon), &used);
+            if (used != colon) frame = -1;
+          } catch (const std::exception&) {
+            frame = -1;
+          }
+          if (frame < 0) return fail("score", "--corners '" + spec + "': expected FRAME:FILE");
+          auto points = vision::read_corners(spec.substr(colon + 1));
+          if (!points) return fail("score", points.error());
+          const vision::StampedPose* at = nullptr;
+          for (const auto& e : *estimates)
+            if (e.frame == frame && e.status != "lost") at = &e;
+          nlohmann::json c{{"frame", frame}, {"file", spec.substr(colon + 1)}, {"present", at != nullptr}};
+          if (at) {
+            const vision::CornerError err = vision::corner_error(*points, at->cam_T_obj, seq->camera());
+            c["rms_px"] = err.rms_px;
+            c["max_px"] = err.max_px;
+          }
+          corner_json.push_back(c);
+        }
+        std::vector<vision::StampedPose> truth_poses;
+        if (!reference->empty()) {
+          auto ref = vision::read_pose_csv(*reference);
+          if (!ref) return fail("score", ref.error());
+          truth_poses = std::move(*ref);
+        } else if (seq->has_ground_truth()) {
+          truth_poses = seq->ground_truth();
+        } else if (corners->empty()) {
+          return fail("score", *seq_dir + " has no gt.csv (no ground truth to score against); give --reference or --corners");
+        }
+        if (truth_poses.empty()) {  // corners only
+          if (*json) {
+            std::cout << nlohmann::json{{"corners", corner_json}}.dump() << std::endl;
+          } else {
+            for (const auto& c : corner_json)
+              std::printf("corners frame %d: %s\n", c["frame"].get<int>(),
+                          c["present"].get<bool>() ? (std::to_string(c["rms_px"].get<double>()) + " px rms, " +
+                                                      std::to_string(c["max_px"].get<double>()) + " px max").c_str()
+                                                   : "no estimate (lost or absent)");
+          }
+          return 0;
+        }
+
         const ScoreSummary summary =
-            vision::score_poses(seq->ground_truth(), *estimates, seq->camera(), seq->model(), axis);
+            vision::score_poses(truth_poses, *estimates, seq->camera(), seq->model(), axis);
         std::set<int> truth_frames;
-        for (const auto& g : seq->ground_truth()) truth_frames.insert(g.frame);
+        for (const auto& g : truth_poses) truth_frames.insert(g.frame);
         int ignored = 0;
         for (const auto& e : *estimates) ignored += truth_frames.count(e.frame) == 0;
 
@@ -139,10 +194,18 @@ const CommandRegistration registration{
                                  {"ignored", ignored},
                                  {"rotation_deg", stats_json(summary.rotation_deg)},
                                  {"translation_mm", stats_json(summary.translation_mm)},
-                                 {"reprojection_px", stats_json(summary.reprojection_px)}};
+                                 {"reprojection_px", stats_json(summary.reprojection_px)},
+                                 {"against", reference->empty() ? "gt.csv" : *reference},
+                                 {"corners", corner_json}};
           std::cout << j.dump() << std::endl;
         } else {
           print_human(*seq_dir, summary, ignored);
+          for (const auto& c : corner_json)
+            if (c["present"].get<bool>())
+              std::printf("corners frame %d   %.2f px rms, %.2f px max\n", c["frame"].get<int>(), c["rms_px"].get<double>(),
+                          c["max_px"].get<double>());
+            else
+              std::printf("corners frame %d   no estimate (lost or absent)\n", c["frame"].get<int>());
         }
         return 0;
       };

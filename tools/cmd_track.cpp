@@ -147,7 +147,8 @@ int run_track(const TrackArgs& args) {
                                     {"changed_by_validation", report.validated_changed}}},
                          {"junctions", report.junctions},
                          {"combinations", report.combinations},
-                         {"scale_px", report.scale_px}});
+                         {"scale_px", report.scale_px},
+                         {"pose_iterations", report.pose_iterations}});
 
     const bool png = args.every > 0 && (i % static_cast<std::size_t>(args.every) == 0 || i + 1 == n);
     if (png || args.video) {

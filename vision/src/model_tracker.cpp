@@ -162,6 +162,7 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   if (pose_ok) {
     estimator_.estimate(problem_, predicted, pose_);
     out.pose_status = pose_.status;
+    out.pose_iterations = pose_.iterations;
     if (pose_.status != PoseStatus::Ok) {
       reasons = reasons | TrackReason::PoseFailed;
       pose_ok = false;

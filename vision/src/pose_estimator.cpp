@@ -321,18 +321,25 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   }
   scale = std::max(options_.min_scale_px, robust_scale(pose));
   feature_rms(pose);
-  // Reject the worst remaining feature if it is an outlier; one at a time, since one gross
-  // outlier can make good features look bad until it is gone.
-  int worst = -1;
+  // Reject the outliers among the worst: every feature beyond the threshold whose RMS is at
+  // least half the worst one's. Not all beyond the threshold at once, since one gross outlier can
+  // make good features look bad until it is gone; not strictly one at a time either, since
+  // several wrong candidates in one frame would each cost a full re-solve.
   double worst_rms = options_.outlier_sigma * scale;
   int remaining = 0;
   for (std::size_t i = 0; i < slots; ++i) {
     if (rejected_[i] || feature_n_[i] == 0) continue;
     ++remaining;
-    if (feature_sq_[i] > worst_rms) { worst_rms = feature_sq_[i]; worst = static_cast<int>(i); }
+    worst_rms = std::max(worst_rms, feature_sq_[i]);
   }
-  if (worst < 0 || remaining <= 3) break;
-  rejected_[worst] = 1;
+  const double cut = std::max(options_.outlier_sigma * scale, 0.5 * worst_rms);
+  int rejected_now = 0;
+  for (std::size_t i = 0; i < slots && remaining - rejected_now > 3; ++i) {
+    if (rejected_[i] || feature_n_[i] == 0 || !(feature_sq_[i] > cut)) continue;
+    rejected_[i] = 1;
+    ++rejected_now;
+  }
+  if (rejected_now == 0) break;
   }
 
   // Final weights, degeneracy check, covariance and per-feature residuals at the solution.

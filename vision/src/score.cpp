@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -91,7 +93,9 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std
   }
   std::unordered_map<int, const StampedPose*> by_frame;
   by_frame.reserve(estimates.size());
-  for (const auto& e : estimates) by_frame.try_emplace(e.frame, &e);
+  // A frame the tracker itself reported as lost carries no estimate (it echoes its prediction).
+  for (const auto& e : estimates)
+    if (e.status != "lost") by_frame.try_emplace(e.frame, &e);
 
   std::vector<const StampedPose*> truth;
   truth.reserve(ground_truth.size());
@@ -134,6 +138,48 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std
   summary.translation_mm = stats_of(std::move(trans));
   summary.reprojection_px = stats_of(std::move(reproj));
   return summary;
+}
+
+
+
+std::expected<std::vector<CornerObservation>, std::string> read_corners(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::unexpected(path + ": cannot open");
+  std::vector<CornerObservation> out;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream fields(line);
+    CornerObservation c;
+    double v[5];
+    int n = 0;
+    while (n < 5 && fields >> v[n]) ++n;
+    if (n == 0 && fields.eof()) continue;  // blank or comment
+    std::string rest;
+    if (n != 5 || (fields >> rest) || !std::isfinite(v[0] + v[1] + v[2] + v[3] + v[4]))
+      return std::unexpected(path + ":" + std::to_string(number) + ": expected X Y Z u v (five numbers)");
+    c.p_obj = {v[0], v[1], v[2]};
+    c.px = {v[3], v[4]};
+    out.push_back(c);
+  }
+  if (out.empty()) return std::unexpected(path + ": no corners");
+  return out;
+}
+
+CornerError corner_error(const std::vector<CornerObservation>& corners, const Eigen::Isometry3d& cam_T_obj,
+                         const Camera& camera) {
+  CornerError e;
+  double sum2 = 0;
+  for (const auto& c : corners) {
+    const Eigen::Vector3d p = cam_T_obj * c.p_obj;
+    const double d = p.z() > 0 ? (camera.project(p) - c.px).norm() : std::numeric_limits<double>::infinity();
+    sum2 += d * d;
+    e.max_px = std::max(e.max_px, d);
+  }
+  e.rms_px = corners.empty() ? 0.0 : std::sqrt(sum2 / static_cast<double>(corners.size()));
+  return e;
 }
 
 }  // namespace epichead::vision

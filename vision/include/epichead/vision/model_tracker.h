@@ -83,6 +83,7 @@ struct FrameReport {
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();  // left perturbation (t, r)
   PoseStatus pose_status = PoseStatus::Ok;
   double scale_px = 0;             // robust residual scale of the pose
+  int pose_iterations = 0;         // Levenberg-Marquardt iterations over all rejection rounds
   int visible = 0;                 // line windows placed
   int found = 0;                   // windows with at least one candidate
   int validated_changed = 0;       // features where validation chose another than RANSAC's best

@@ -1,7 +1,9 @@
 #pragma once
 // Scoring of estimated poses against ground truth: per-frame rotation, translation and
 // reprojection errors, success under the 5 cm / 5 degree criterion, and a summary.
+#include <expected>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,7 +37,7 @@ struct ScoreSummary {
 };
 
 // Scores `estimates` against `ground_truth` frame by frame (matched on the frame column).
-// A ground-truth frame without an estimate fails. With sym_axis_obj (a unit axis through the
+// A ground-truth frame without an estimate, or whose estimate has status "lost", fails. With sym_axis_obj (a unit axis through the
 // object origin), the turn about it that makes the estimate closest to the truth is removed
 // first, since it is unobservable for a body of revolution.
 ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth,
@@ -43,5 +45,17 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth,
                          const CadModel& model,
                          const std::optional<Eigen::Vector3d>& sym_axis_obj = std::nullopt,
                          const ScoreCriterion& criterion = {});
+
+// A model point read by hand in an image (real video has no ground truth): X Y Z u v per line.
+struct CornerObservation {
+  Eigen::Vector3d p_obj = Eigen::Vector3d::Zero();
+  Eigen::Vector2d px = Eigen::Vector2d::Zero();
+};
+struct CornerError { double rms_px = 0, max_px = 0; };
+// Reads "X Y Z u v" lines ('#' starts a comment); errors say file:line.
+std::expected<std::vector<CornerObservation>, std::string> read_corners(const std::string& path);
+// Distance of the projected model points from the hand-read pixels at a pose.
+CornerError corner_error(const std::vector<CornerObservation>& corners, const Eigen::Isometry3d& cam_T_obj,
+                         const Camera& camera);
 
 }  // namespace epichead::vision
