@@ -86,7 +86,6 @@ void ModelTracker::reset() {
   lines_.reset();
   std::fill(kept_last_.begin(), kept_last_.end(), kNotVisible);
   was_lost_ = false;
-  first_frame_ = true;
 }
 
 void ModelTracker::build_problem() {
@@ -122,19 +121,16 @@ void ModelTracker::build_problem() {
   }
 }
 
-void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
-  const auto t_start = Clock::now();
-  out = FrameReport{};
-  out.cam_T_obj = predicted;
-
+bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
   auto t = Clock::now();
   visibility_.compute(predicted, visible_);
-  out.times.visibility_ms = ms_since(t);
+  out.times.visibility_ms += ms_since(t);
 
   t = Clock::now();
   lines_.detect(image, visible_, WindowPlacement::Projection);
-  out.times.epic_ms = ms_since(t);
+  out.times.epic_ms += ms_since(t);
   const auto& features = lines_.features();
+  out.visible = out.found = 0;
   for (const LineFeature& f : features) {
     out.visible += f.visible;
     out.found += f.visible && f.selected >= 0;
@@ -144,9 +140,9 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   if (options_.mode == TrackMode::EpicValidation) {
     validator_.validate(image, features, validation_);
     out.validated_changed = validation_.changed;
-    out.combinations = validation_.combinations;
+    out.combinations += validation_.combinations;
   }
-  out.times.validation_ms = ms_since(t);
+  out.times.validation_ms += ms_since(t);
 
   t = Clock::now();
   build_problem();
@@ -159,10 +155,11 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   if (out.visible < 3) reasons = reasons | TrackReason::NotVisible;
   if (out.found < options_.min_features) reasons = reasons | TrackReason::FewFeatures;
   bool pose_ok = reasons == TrackReason::None;
+  out.inliers = out.rejected = 0;
   if (pose_ok) {
     estimator_.estimate(problem_, predicted, pose_);
     out.pose_status = pose_.status;
-    out.pose_iterations = pose_.iterations;
+    out.pose_iterations += pose_.iterations;
     if (pose_.status != PoseStatus::Ok) {
       reasons = reasons | TrackReason::PoseFailed;
       pose_ok = false;
@@ -207,8 +204,18 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
       if (pose_.scale_px > 2 * options_.max_scale_px) pose_ok = false;
     }
   }
-  out.times.pose_ms = ms_since(t);
+  out.times.pose_ms += ms_since(t);
+  out.reasons = reasons;
+  return pose_ok;
+}
 
+void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
+  const auto t_start = Clock::now();
+  out = FrameReport{};
+  out.cam_T_obj = predicted;
+  const bool pose_ok = measure(image, predicted, out);
+  const auto& features = lines_.features();
+  TrackReason reasons = out.reasons;
   if (!pose_ok) {
     out.status = TrackStatus::Lost;
     out.cam_T_obj = predicted;
@@ -234,7 +241,6 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   }
   out.reasons = reasons;
   was_lost_ = out.status == TrackStatus::Lost;
-  first_frame_ = false;
   std::swap(kept_last_, kept_now_);
   out.times.total_ms = ms_since(t_start);
 }

@@ -114,6 +114,10 @@ class ModelTracker {
 
  private:
   void build_problem();
+  // One measurement from a predicted pose: windows, candidates, validation, pose and its
+  // checks; sets the counts and reasons of `out` and adds to its stage times. True when the
+  // pose is usable. Learns nothing (references change only in track()).
+  bool measure(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out);
   const CadModel* model_;
   Camera camera_;
   ModelTrackerOptions options_;
@@ -129,7 +133,6 @@ class ModelTracker {
   std::vector<unsigned char> kept_last_;      // per model edge: found and kept by the pose last frame
   std::vector<unsigned char> kept_now_;
   bool was_lost_ = false;
-  bool first_frame_ = true;
 };
 
 }  // namespace epichead::vision

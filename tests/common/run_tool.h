@@ -1,0 +1,39 @@
+#pragma once
+// Runs the built `epichead` program (EPICHEAD_BIN) with shell-quoted arguments, capturing its
+// exit code, stdout and stderr, for the end-to-end tests under tests/tools.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "common/temp_dir.h"
+
+namespace epichead::testing {
+
+struct ToolRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// `epichead <args>`; the captured streams go through files in `scratch`.
+inline ToolRun run_epichead(const TempDir& scratch, const std::string& args) {
+  const std::string out = scratch / "stdout.txt", err = scratch / "stderr.txt";
+  const std::string command = "'" + std::string(EPICHEAD_BIN) + "' " + args + " > '" + out + "' 2> '" + err + "'";
+  const int status = std::system(command.c_str());
+  ToolRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+}  // namespace epichead::testing

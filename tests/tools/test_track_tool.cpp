@@ -1,0 +1,89 @@
+// `epichead track` end to end: a short simulated mockup_walk sequence tracked to its success
+// target and scored, the real teabox video against its hand-read corners, and the errors a user
+// meets first.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "common/run_tool.h"
+#include "common/temp_dir.h"
+
+using epichead::testing::run_epichead;
+using epichead::testing::slurp;
+using epichead::testing::TempDir;
+
+namespace {
+namespace fs = std::filesystem;
+std::string q(const std::string& s) { return "'" + s + "'"; }
+}  // namespace
+
+TEST_CASE("track follows a short simulated mockup_walk with epic+validation and writes every output") {
+  TempDir tmp("epichead_test_track_tool");
+  const std::string seq = tmp / "mockup_walk", out = tmp / "track";
+  REQUIRE(run_epichead(tmp, "sim mockup_walk --out " + q(seq) + " --frames 40").exit_code == 0);
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 20");
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  CHECK(report["frames"] == 40);
+  CHECK(report["tracked"].get<int>() + report["lost"].get<int>() == 40);
+  // The target (>= 99 % on mockup_walk at the default jerk) is measured on the full
+  // sequence by tools/results.sh; in these 40 frames one step burst may outrun the windows
+  // without IMU prediction (it is then reported lost, and re-acquired on the next frame).
+  CHECK(report["lost"].get<int>() <= 1);
+  CHECK(report["track_ms_median"].get<double>() > 0);
+  CHECK(report["per_frame"].size() == 40);
+  CHECK(report["per_frame"][5]["lines"]["visible"].get<int>() >= 25);
+  CHECK(fs::exists(out + "/overlay_000000.png"));
+  CHECK(fs::exists(out + "/overlay_000020.png"));
+  CHECK(fs::exists(out + "/overlay_000039.png"));
+  CHECK(fs::exists(out + "/overlay.mp4"));
+
+  const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --json");
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["success_rate"].get<double>() >= 0.97);
+  CHECK(s["rotation_deg"]["median"].get<double>() < 1.0);
+  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+}
+
+TEST_CASE("track follows the real teabox video to within a few pixels of the hand-read corners") {
+  TempDir tmp("epichead_test_track_tool");
+  const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox", out = tmp / "teabox";
+  const auto run = run_epichead(tmp, "track " + q(data) + " --out " + q(out) + " --every 0 --no-video");
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  CHECK(report["lost"] == 0);
+  const auto score = run_epichead(tmp, "score " + q(data) + " " + q(out + "/poses.csv") + " --json --reference " +
+                                           q(data + "/reference_visp.csv") + " --corners 0:" +
+                                           q(data + "/corners_frame000.txt") + " --corners 38:" +
+                                           q(data + "/corners_frame038.txt"));
+  INFO(score.err);
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["success_rate"].get<double>() == 1.0);  // within 5 cm / 5 deg of the peer's poses
+  for (const auto& c : s["corners"]) {
+    CHECK(c["present"] == true);
+    CHECK(c["rms_px"].get<double>() < 8.0);  // hand-read to +-2..3 px
+  }
+}
+
+TEST_CASE("track rejects bad arguments with one line and a non-zero exit") {
+  TempDir tmp("epichead_test_track_tool");
+  const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox";
+  auto r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --mode sharpest");
+  CHECK(r.exit_code != 0);
+  CHECK(r.err.find("--mode") != std::string::npos);
+  r = run_epichead(tmp, "track " + q(tmp / "missing") + " --out " + q(tmp / "x"));
+  CHECK(r.exit_code != 0);
+  CHECK(r.err.find("missing") != std::string::npos);
+  r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --imu on");
+  CHECK(r.exit_code != 0);
+  CHECK(r.err.find("imu.csv") != std::string::npos);
+  r = run_epichead(tmp, "track --help");
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.find("--mode") != std::string::npos);
+}
