@@ -1,0 +1,51 @@
+#pragma once
+// One line of a can-utils candump log, parsed or formatted without allocation.
+//
+// Log format (candump -l, what canplayer reads and what we write):
+//   (1436509052.249713) can0 123#DEADBEEF         classic, 11-bit id (3 hex digits)
+//   (1436509052.249713) can0 1F334455#00          29-bit id (8 hex digits)
+//   (1436509052.249713) can0 123#R  / 123#R4      remote frame, optional length digit
+//   (1436509052.249713) can0 20000004#0004000000000000   error frame (id has the error flag 0x20000000)
+//   (1436509052.249713) can0 123##1DEADBEEF       CAN FD: flags nibble (1 = BRS, 2 = ESI), data
+//   ... 123#11.22.33         dots between bytes are allowed; "_X" after 8 bytes (raw DLC) too
+//   ... 123#DEADBEEF R       a trailing direction (R = received, T = transmitted)
+// Default (human-readable) candump output is read too, with or without a "(stamp)" prefix:
+//   "  can0  680   [8]  03 22 01 00 00 00 00 00", "  can0  123   [2]  remote request"
+// Blank lines and lines starting with '#' are skipped; a trailing '\r' (CRLF) is ignored.
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "epichead/firmware_iface/can_frame.h"
+
+namespace epichead::firmware_iface {
+
+enum class CanDirection : std::uint8_t { Unknown, Received, Transmitted };
+
+struct CandumpRecord {
+  StampedCanFrame frame;       // stamp_us: the "(sec.usec)" time, 0 when the line has none
+  bool has_stamp = false;
+  std::string_view iface;      // points into the line (valid as long as the line is)
+  CanDirection direction = CanDirection::Unknown;
+};
+
+enum class CandumpLineKind : std::uint8_t { Frame, Skip /* blank or comment */, Malformed };
+
+struct CandumpParse {
+  CandumpLineKind kind = CandumpLineKind::Malformed;
+  const char* reason = "";  // for Malformed: what is wrong (a string literal)
+  int column = 0;           // for Malformed: 1-based column where parsing stopped
+};
+
+// Parses one line (without its '\n'). On Frame, `out` holds the record.
+CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out);
+
+// The longest line format_candump_line writes (FD, 64 bytes, 15-char iface name).
+inline constexpr std::size_t kCandumpMaxLine = 160;
+
+// Formats a frame in the log format (with '\n') into buf (kCandumpMaxLine bytes at least);
+// returns the length. A Direction other than Unknown is appended as " R" / " T".
+std::size_t format_candump_line(const StampedCanFrame& frame, std::string_view iface, char* buf,
+                                CanDirection direction = CanDirection::Unknown);
+
+}  // namespace epichead::firmware_iface

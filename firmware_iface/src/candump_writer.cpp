@@ -1,0 +1,49 @@
+#include "epichead/firmware_iface/candump_writer.h"
+
+#include <cerrno>
+#include <cstring>
+#include <utility>
+
+namespace epichead::firmware_iface {
+
+std::expected<CandumpWriter, std::string> CandumpWriter::open(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) return std::unexpected(path + ": cannot open for writing (" + std::strerror(errno) + ")");
+  return CandumpWriter(f, path);
+}
+
+CandumpWriter::CandumpWriter(CandumpWriter&& o) noexcept { *this = std::move(o); }
+
+CandumpWriter& CandumpWriter::operator=(CandumpWriter&& o) noexcept {
+  if (this == &o) return *this;
+  if (file_) std::fclose(file_);
+  file_ = std::exchange(o.file_, nullptr);
+  path_ = std::move(o.path_);
+  frames_ = o.frames_;
+  return *this;
+}
+
+CandumpWriter::~CandumpWriter() {
+  if (file_) std::fclose(file_);
+}
+
+std::expected<void, std::string> CandumpWriter::write(const StampedCanFrame& frame, std::string_view iface,
+                                                      CanDirection direction) {
+  if (!file_) return std::unexpected(path_ + ": writer is closed");
+  if (iface.empty() || iface.find_first_of(" \t\r\n") != std::string_view::npos)
+    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is empty or has blanks");
+  char line[kCandumpMaxLine];
+  const std::size_t n = format_candump_line(frame, iface, line, direction);
+  if (std::fwrite(line, 1, n, file_) != n) return std::unexpected(path_ + ": write error (" + std::strerror(errno) + ")");
+  ++frames_;
+  return {};
+}
+
+std::expected<void, std::string> CandumpWriter::close() {
+  if (!file_) return {};
+  const int rc = std::fclose(std::exchange(file_, nullptr));
+  if (rc != 0) return std::unexpected(path_ + ": error while closing (" + std::strerror(errno) + ")");
+  return {};
+}
+
+}  // namespace epichead::firmware_iface
