@@ -34,6 +34,7 @@ struct TrackArgs {
   int max_frames = 0;
   bool video = true;
   double crease_deg = 20.0;
+  double imu_time_offset_s = 0;
 };
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
@@ -64,6 +65,13 @@ void draw_frame(cv::Mat& canvas, const ModelTracker& tracker, const FrameReport&
       }
     }
   }
+  for (const EllipseFeature& e : tracker.ellipses().features()) {
+    if (!e.visible || !e.found) continue;
+    const Ellipse& el = e.ellipse;
+    cv::ellipse(canvas, cv::Point(cvRound(el.centre_px.x() * 16), cvRound(el.centre_px.y() * 16)),
+                cv::Size(cvRound(el.semi_major_px * 16), cvRound(el.semi_minor_px * 16)), el.angle_rad * 180 / M_PI, 0, 360,
+                e.weak ? cv::Scalar(0, 165, 255) : cv::Scalar(0, 255, 0), 2, cv::LINE_AA, shift);
+  }
   if (validated)
     for (const ValidatedJunction& j : tracker.validation().junctions)
       cv::circle(canvas, P(j.px), 4 * 16, {255, 255, 0}, 1, cv::LINE_AA, shift);
@@ -91,7 +99,7 @@ int run_track(const TrackArgs& args) {
   if (args.imu != "on" && args.imu != "off") return fail(cmd, "--imu must be on or off, got '" + args.imu + "'");
   auto seq = Sequence::open(args.seq);
   if (!seq) return fail(cmd, seq.error());
-  auto predictor = make_track_predictor(*seq, args.imu == "on");
+  auto predictor = make_track_predictor(*seq, args.imu == "on", args.imu_time_offset_s);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -145,6 +153,9 @@ int run_track(const TrackArgs& args) {
                                     {"rejected", report.rejected},
                                     {"recovered", report.recovered},
                                     {"changed_by_validation", report.validated_changed}}},
+                         {"ellipses", {{"visible", report.ellipses_visible},
+                                       {"found", report.ellipses_found},
+                                       {"weak", report.ellipses_weak}}},
                          {"junctions", report.junctions},
                          {"combinations", report.combinations},
                          {"scale_px", report.scale_px},
@@ -223,6 +234,8 @@ const CommandRegistration registration{
       app.add_option("--every", a->every, "Write a PNG overlay every N frames and at the last (0: none; default 30)")
           ->check(CLI::Range(0, 1000000));
       app.add_option("--frames", a->max_frames, "Track only the first N frames (0: all)")->check(CLI::Range(0, 100000000));
+      app.add_option("--imu-time-offset-s", a->imu_time_offset_s,
+                     "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset; default 0)");
       app.add_flag("!--no-video", a->video, "Do not write overlay.mp4");
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
       return [a]() { return run_track(*a); };

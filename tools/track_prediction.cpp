@@ -1,5 +1,9 @@
 #include "track_prediction.h"
 
+#include <cmath>
+
+#include "epichead/fusion/predictor.h"
+
 namespace epichead::tools {
 namespace {
 
@@ -40,12 +44,104 @@ class ConstantVelocityPredictor final : public TrackPredictor {
   int lost_ = 0;
 };
 
+// The Kalman predictor fed with the sequence's imu.csv: before each frame every IMU sample up
+// to the frame's time is propagated; each tracked pose is a vision update at its exposure time.
+// While the object is lost the gyro keeps the orientation, so windows follow a turning camera;
+// after lost_reset_s without a pose the filter restarts from the next one.
+class ImuPredictor final : public TrackPredictor {
+ public:
+  ImuPredictor(fusion::Predictor predictor, const vision::Sequence& seq, double time_offset_s)
+      : predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(time_offset_s), last_good_(seq.init().cam_T_obj) {
+    // The initial pose seeds the filter like a vision result with a loose covariance.
+    pending_init_ = true;
+    init_t_s_ = seq.init().t_s;
+  }
+  Eigen::Isometry3d predict(double t_s) override {
+    feed_until(t_s);
+    if (pending_init_) {
+      fusion::Matrix6d cov = fusion::Matrix6d::Zero();
+      cov.diagonal() << 1e-4, 1e-4, 1e-4, 3e-4, 3e-4, 3e-4;  // 1 cm, 1 deg: init.csv's accuracy
+      const auto r = predictor_.add_vision(init_t_s_, last_good_, cov);
+      pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
+    }
+    if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
+    ++fallbacks_;
+    return last_good_;
+  }
+  void observe(double t_s, const vision::FrameReport& report) override {
+    if (report.status == vision::TrackStatus::Lost) {
+      ++lost_;
+      if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
+        predictor_.reset();
+        reset_done_ = true;
+        ++resets_;
+      }
+      return;
+    }
+    reset_done_ = false;
+    last_good_ = report.cam_T_obj;
+    last_good_t_s_ = t_s;
+    // The estimator's covariance assumes independent edgels; neighbouring edgels of one blurred
+    // edge are not, so it is optimistic by about the number of edgels per line: inflate it.
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, kCovarianceInflation * report.covariance);
+    if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld) pending_init_ = false;
+  }
+  nlohmann::json diagnostics() const override {
+    const auto st = predictor_.status(last_good_t_s_);
+    const auto& c = st.counters;
+    return {{"model", "imu"},
+            {"imu_time_offset_s", offset_s_},
+            {"imu_accepted", c.imu_accepted},
+            {"imu_rejected", c.imu_non_finite + c.imu_saturated + c.imu_out_of_order + c.imu_duplicate},
+            {"imu_saturated", c.imu_saturated},
+            {"dropouts", c.dropouts},
+            {"vision_applied", c.vision_applied},
+            {"vision_initialised", c.vision_initialised},
+            {"vision_gated", c.vision_gated},
+            {"vision_too_old", c.vision_too_old},
+            {"reinitialisations", c.reinitialisations},
+            {"resets_after_loss", resets_},
+            {"fallbacks_to_last_pose", fallbacks_},
+            {"lost_frames", lost_}};
+  }
+
+ private:
+  static constexpr double kLostResetS = 1.0;
+  static constexpr double kCovarianceInflation = 10.0;
+  void feed_until(double t_s) {
+    const auto& imu = *imu_;
+    while (next_ < imu.size() && imu[next_].t_s - offset_s_ <= t_s) {
+      fusion::ImuSample s;
+      s.t_s = imu[next_].t_s;
+      s.gyro_radps = imu[next_].gyro_radps;
+      s.accel_mps2 = imu[next_].accel_mps2;
+      predictor_.add_imu(s);
+      ++next_;
+    }
+  }
+  fusion::Predictor predictor_;
+  const std::vector<vision::ImuRecord>* imu_;
+  std::size_t next_ = 0;
+  double offset_s_ = 0;
+  Eigen::Isometry3d last_good_;
+  double last_good_t_s_ = 0, init_t_s_ = 0;
+  bool pending_init_ = false, reset_done_ = false;
+  int lost_ = 0, resets_ = 0, fallbacks_ = 0;
+};
+
 }  // namespace
 
-std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu) {
+std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
+                                                                                 double imu_time_offset_s) {
   if (use_imu) {
     if (!seq.has_imu()) return std::unexpected("--imu on: " + seq.dir() + " has no imu.csv");
-    return std::unexpected("--imu on: the IMU predictor is not wired yet");
+    if (!std::isfinite(imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
+    fusion::PredictorOptions options;
+    options.mode = fusion::PredictorMode::ImuAided;
+    options.imu_time_offset_s = imu_time_offset_s;
+    auto predictor = fusion::Predictor::create(options);
+    if (!predictor) return std::unexpected("--imu on: " + predictor.error());
+    return std::make_unique<ImuPredictor>(std::move(*predictor), seq, imu_time_offset_s);
   }
   return std::make_unique<ConstantVelocityPredictor>(seq.init().t_s, seq.init().cam_T_obj);
 }

@@ -25,7 +25,9 @@ class TrackPredictor {
   virtual nlohmann::json diagnostics() const = 0;
 };
 
-// --imu on needs the sequence's imu.csv; the error says so when it is missing.
-std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu);
+// --imu on needs the sequence's imu.csv; the error says so when it is missing. The IMU's clock
+// runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset).
+std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
+                                                                                 double imu_time_offset_s = 0);
 
 }  // namespace epichead::tools

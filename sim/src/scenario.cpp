@@ -358,6 +358,48 @@ class Parser {
     numbers("imu_dropouts", {&m.dropouts_per_s, &m.dropout_s}, 0, 100);
     numbers("imu_clock_offset_s", {&m.clock_offset_s}, -1e6, 1e6);
     numbers("imu_clock_drift_ppm", {&m.clock_drift}, -1e5, 1e5, std::nullopt, 1e-6);
+
+    // Closed loop: bus timing, head dynamics, camera delivery, faults.
+    numbers("bus_latency_us", {&sc_.bus.latency_us}, 0, 1e6);
+    numbers("bus_jitter_us", {&sc_.bus.jitter_us}, 0, 1e6);
+    numbers("bus_drop_rate", {&sc_.bus.drop_rate}, 0, 1);
+    numbers("command_latency_us", {&sc_.bus.command_latency_us}, 0, 1e6);
+    HeadDynamics& h = sc_.head_dynamics;
+    numbers("head_time_constant_s", {&h.time_constant_s}, 1e-4, 10);
+    numbers("head_rate_limit_radps", {&h.rate_limit_radps}, 0.01, 100);
+    numbers("head_accel_limit_radps2", {&h.accel_limit_radps2}, 0.1, 1e5);
+    numbers("head_backlash_rad", {&h.backlash_rad}, 0, 0.5);
+    numbers("head_state_rate_hz", {&h.state_rate_hz}, 1, 10000);
+    numbers("head_command_timeout_s", {&h.command_timeout_s}, 0.001, 1e6);
+    numbers("camera_latency_s", {&sc_.camera_latency_s}, 0, 10);
+    rules_["fault"] = {3, 4, true, std::nullopt, [this](const Args& a) -> Status {
+      FaultWindow f;
+      std::size_t next = 1;
+      if (a[0] == "imu_dropout") f.kind = FaultKind::imu_dropout;
+      else if (a[0] == "bus_off") f.kind = FaultKind::bus_off;
+      else if (a[0] == "camera_stall") f.kind = FaultKind::camera_stall;
+      else if (a[0] == "stuck_joint") {
+        f.kind = FaultKind::stuck_joint;
+        if (a[1] == "pan") f.joint = Joint::pan;
+        else if (a[1] == "tilt") f.joint = Joint::tilt;
+        else return std::unexpected(where() + "'fault stuck_joint': unknown joint '" + a[1] + "' (known: pan, tilt)");
+        next = 2;
+      } else {
+        return std::unexpected(where() + "'fault': unknown fault '" + a[0] +
+                               "' (known: imu_dropout, bus_off, camera_stall, stuck_joint)");
+      }
+      if (a.size() != next + 2)
+        return std::unexpected(where() + "'fault " + a[0] + "' takes " + (next == 2 ? "JOINT " : "") +
+                               "START_S DURATION_S");
+      auto t = num(a[next], 0, 1e6);
+      if (!t) return std::unexpected(t.error());
+      auto d = num(a[next + 1], 0, 1e6);
+      if (!d) return std::unexpected(d.error());
+      f.start_s = *t;
+      f.duration_s = *d;
+      sc_.faults.push_back(f);
+      return {};
+    }};
   }
 
   std::string name_, base_dir_, key_;

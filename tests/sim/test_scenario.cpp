@@ -185,3 +185,63 @@ TEST_CASE("the tracked object stays in view in every frame of every built-in sce
     CHECK(worst >= 0.8);
   }
 }
+
+TEST_CASE("closed-loop keys: bus timing, head dynamics, camera latency and faults are read", "[sim][scenario]") {
+  const std::string text = kMinimal +
+                           "bus_latency_us 150\nbus_jitter_us 40\nbus_drop_rate 0.02\ncommand_latency_us 900\n"
+                           "head_time_constant_s 0.03\nhead_rate_limit_radps 5\nhead_accel_limit_radps2 80\n"
+                           "head_backlash_rad 0.002\nhead_state_rate_hz 100\nhead_command_timeout_s 0.2\n"
+                           "camera_latency_s 0.02\nfault imu_dropout 4.0 0.5\nfault bus_off 6 0.3\n"
+                           "fault camera_stall 8.0 0.4\nfault stuck_joint tilt 9.0 1.0\n";
+  auto s = parse_scenario(text, "t.scn");
+  INFO((s ? "" : s.error()));
+  REQUIRE(s);
+  CHECK(s->bus.latency_us == 150);
+  CHECK(s->bus.jitter_us == 40);
+  CHECK(s->bus.drop_rate == 0.02);
+  CHECK(s->bus.command_latency_us == 900);
+  CHECK(s->head_dynamics.time_constant_s == 0.03);
+  CHECK(s->head_dynamics.rate_limit_radps == 5);
+  CHECK(s->head_dynamics.accel_limit_radps2 == 80);
+  CHECK(s->head_dynamics.backlash_rad == 0.002);
+  CHECK(s->head_dynamics.state_rate_hz == 100);
+  CHECK(s->head_dynamics.command_timeout_s == 0.2);
+  CHECK(s->camera_latency_s == 0.02);
+  REQUIRE(s->faults.size() == 4);
+  CHECK(s->faults[0].kind == FaultKind::imu_dropout);
+  CHECK(s->faults[0].start_s == 4.0);
+  CHECK(s->faults[0].duration_s == 0.5);
+  CHECK(s->faults[1].kind == FaultKind::bus_off);
+  CHECK(s->faults[2].kind == FaultKind::camera_stall);
+  CHECK(s->faults[3].kind == FaultKind::stuck_joint);
+  CHECK(s->faults[3].joint == Joint::tilt);
+  CHECK(s->faults[3].start_s == 9.0);
+  const FaultPlan plan(s->faults);
+  CHECK(plan.active(FaultKind::bus_off, 6.1));
+  CHECK(!plan.active(FaultKind::bus_off, 6.3));
+  CHECK(plan.joint_stuck(Joint::tilt, 9.5));
+  CHECK(!plan.joint_stuck(Joint::pan, 9.5));
+  CHECK(plan.started(FaultKind::bus_off, 5.9) == 0);
+  CHECK(plan.started(FaultKind::bus_off, 7) == 1);
+
+  // Defaults: a scenario without the keys runs closed-loop with a plausible bus and head.
+  auto d = parse_scenario(kMinimal, "t.scn");
+  REQUIRE(d);
+  CHECK(d->faults.empty());
+  CHECK(d->bus.latency_us > 0);
+  CHECK(d->head_dynamics.time_constant_s > 0);
+}
+
+TEST_CASE("closed-loop keys: bad faults and values name the file and line", "[sim][scenario]") {
+  CHECK(contains(error_of(kMinimal + "fault meltdown 1 2\n", 4), "unknown fault 'meltdown'"));
+  CHECK(contains(error_of(kMinimal + "fault stuck_joint elbow 1 2\n", 4), "unknown joint 'elbow'"));
+  CHECK(contains(error_of(kMinimal + "fault stuck_joint 1 2\n", 4), "unknown joint '1'"));
+  CHECK(contains(error_of(kMinimal + "fault bus_off 1 2 3\n", 4), "takes START_S DURATION_S"));
+  CHECK(contains(error_of(kMinimal + "fault stuck_joint pan 1\n", 4), "takes JOINT START_S DURATION_S"));
+  CHECK(contains(error_of(kMinimal + "fault bus_off -1 2\n", 4), "out of range"));
+  CHECK(contains(error_of(kMinimal + "fault bus_off 1 x\n", 4), "not a number"));
+  CHECK(contains(error_of(kMinimal + "fault bus_off\n", 4), "takes 3 to 4 value(s)"));
+  CHECK(contains(error_of(kMinimal + "bus_drop_rate 1.5\n", 4), "out of range"));
+  CHECK(contains(error_of(kMinimal + "head_time_constant_s 0\n", 4), "out of range"));
+  CHECK(contains(error_of(kMinimal + "bus_latency_us 10\nbus_latency_us 20\n", 5), "given twice"));
+}

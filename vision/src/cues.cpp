@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #if defined(__SSE4_1__)
 #include <immintrin.h>
@@ -69,6 +70,53 @@ inline __m128 exp_neg4(__m128 x) {
 }  // namespace
 #endif
 
+#if defined(__SSE4_1__)
+namespace {
+
+// Byte masks by lane: lanes_below(n) has lanes j < n set, lanes_from(s) lanes j >= s (0..16).
+alignas(16) constexpr std::uint8_t kOnesThenZeros[32] = {
+    0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+alignas(16) constexpr std::uint8_t kZerosThenOnes[32] = {
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+    0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+inline __m128i lanes_below(int n) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(kOnesThenZeros + 16 - n)); }
+inline __m128i lanes_from(int s) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(kZerosThenOnes + 16 - s)); }
+
+// Prefix counts of up to 16 byte bins: lane j = #{k <= j : b_k == b_j}. One compare of the
+// register with itself shifted by s lanes adds the matches at distance s to every lane at once,
+// so an interval of n pixels costs n - 1 compares instead of n histogram updates and clears.
+// All three channels go through one loop, so they share its exit test.
+template <int S>
+inline void add_matches(__m128i b, __m128i& count) {
+  count = _mm_sub_epi8(count, _mm_and_si128(_mm_cmpeq_epi8(b, _mm_slli_si128(b, S)), lanes_from(S)));
+}
+template <int... S>
+inline void prefix_counts(const __m128i (&b)[3], int n, __m128i (&count)[3], std::integer_sequence<int, S...>) {
+  for (__m128i& c : count) c = _mm_set1_epi8(1);
+  // S + 1 = the shift; the fold stops at the first shift >= n (no lane has such a neighbour).
+  (void)((n > S + 1 && (add_matches<S + 1>(b[0], count[0]), add_matches<S + 1>(b[1], count[1]),
+                        add_matches<S + 1>(b[2], count[2]), true)) && ...);
+}
+
+// The mode of n <= 16 byte bins with the histogram loop's tie rule (the first bin to reach the
+// top count wins, i.e. the first lane whose prefix count is the maximum). Returns the mask of
+// the lanes in the modal bin and sets `top` to its count.
+inline __m128i modal_lanes(__m128i b, __m128i count, __m128i valid, int& top) {
+  count = _mm_and_si128(count, valid);
+  // Key per lane: count in the high byte, 15 - lane in the low byte, so the largest key is the
+  // first lane with the top count. PHMINPOSUW finds the smallest of eight complemented keys.
+  const __m128i code = _mm_setr_epi8(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+  const __m128i key = _mm_max_epu16(_mm_unpacklo_epi8(code, count), _mm_unpackhi_epi8(code, count));
+  const int best = 0xFFFF & ~_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(key, _mm_set1_epi8(-1))));
+  top = best >> 8;
+  const int lane = 15 - (best & 0xFF);
+  const __m128i mode = _mm_shuffle_epi8(b, _mm_set1_epi8(static_cast<char>(lane)));
+  return _mm_and_si128(_mm_cmpeq_epi8(b, mode), valid);
+}
+
+}  // namespace
+#endif
+
 void cue_agreements(const IntervalCues* cues, int n, const CueReference& ref, bool colour, float* out) {
   int j = 0;
 #if defined(__SSE4_1__)
@@ -107,6 +155,9 @@ CueHistograms::CueHistograms(const CueOptions& options) : options_(options) {
   count_i_.assign(2 * static_cast<std::size_t>(options_.intensity_bins), 0);
   count_c_.assign(2 * nc, 0);
   count_t_.assign(2 * static_cast<std::size_t>(options_.texture_bins), 0);
+  // Intensity and texture bins are at most 256 by the clamps above; the 2-D chroma bin fits a
+  // byte up to 16 x 16.
+  byte_bins_ = options_.chroma_bins <= 16;
 }
 
 void CueHistograms::prepare(const LineWindow& window) {
@@ -114,8 +165,14 @@ void CueHistograms::prepare(const LineWindow& window) {
   const int n = g.rows * g.cols;
   if (n > capacity_) {  // first window (or a larger one): warm-up only
     capacity_ = std::max(n, window.options().width_px * window.options().max_rows);
-    bins_.resize(capacity_);
-    values_.resize(4 * static_cast<std::size_t>(capacity_));
+    if (!byte_bins_) bins_.resize(capacity_);
+    // 16 pixels of padding: the short-interval path loads 16 pixels from an interval's start.
+    const std::size_t padded = static_cast<std::size_t>(capacity_) + 16;
+    if (byte_bins_) {
+      bin8_i_.resize(padded);
+      bin8_c_.resize(padded);
+      bin8_t_.resize(padded);
+    }
   }
   const float* I = window.plane(CueChannel::Intensity);
   const float* R = window.plane(CueChannel::ChromaR);
@@ -126,24 +183,46 @@ void CueHistograms::prepare(const LineWindow& window) {
   // Clamped in float, then truncated: branch-free, so the loop vectorises.
   const float top_i = ni - 0.5f, top_c = nc - 0.5f, top_t = nt - 0.5f;
   std::uint64_t* __restrict bins = bins_.data();
+  std::uint8_t* __restrict b8i = bin8_i_.data();
+  std::uint8_t* __restrict b8c = bin8_c_.data();
+  std::uint8_t* __restrict b8t = bin8_t_.data();
+  const bool bytes = byte_bins_;
   auto clampf = [](float v, float hi) { v = v > 0.0f ? v : 0.0f; return v < hi ? v : hi; };
   int p = 0;
 #if defined(__SSE4_1__)
   {
-    // Four pixels per pass: the same clamps (max/min against 0 and the top, NaN -> 0) and
-    // truncations as the scalar loop, then the three bins packed into two 64-bit words.
+    // The same clamps (max/min against 0 and the top, NaN -> 0) and truncations as the scalar
+    // loop, four pixels per register.
     const __m128 zero = _mm_setzero_ps(), vsi = _mm_set1_ps(si), vsc = _mm_set1_ps(sc), vst = _mm_set1_ps(st);
     const __m128 vti = _mm_set1_ps(top_i), vtc = _mm_set1_ps(top_c), vtt = _mm_set1_ps(top_t);
     const __m128i vnc = _mm_set1_epi32(nc);
     auto bin4 = [&](const float* x, __m128 scale, __m128 top) {
       return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_loadu_ps(x), scale), zero), top));
     };
-    for (; p + 4 <= n; p += 4) {
-      const __m128i bi = bin4(I + p, vsi, vti), bt = bin4(T + p, vst, vtt);
-      const __m128i bc = _mm_add_epi32(_mm_mullo_epi32(bin4(R + p, vsc, vtc), vnc), bin4(G + p, vsc, vtc));
-      const __m128i lo = _mm_or_si128(bi, _mm_slli_epi32(bc, 16));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p), _mm_unpacklo_epi32(lo, bt));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p + 2), _mm_unpackhi_epi32(lo, bt));
+    auto bin_c4 = [&](int q) {
+      return _mm_add_epi32(_mm_mullo_epi32(bin4(R + q, vsc, vtc), vnc), bin4(G + q, vsc, vtc));
+    };
+    if (bytes) {
+      // Sixteen pixels per pass, each channel narrowed to one register of bytes (bins < 256,
+      // so the saturating packs keep them) and stored at once.
+      auto narrow = [](__m128i a, __m128i b, __m128i c, __m128i d) {
+        return _mm_packus_epi16(_mm_packus_epi32(a, b), _mm_packus_epi32(c, d));
+      };
+      auto store16 = [](std::uint8_t* dst, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(dst), v); };
+      for (; p + 16 <= n; p += 16) {
+        store16(b8i + p, narrow(bin4(I + p, vsi, vti), bin4(I + p + 4, vsi, vti), bin4(I + p + 8, vsi, vti),
+                                bin4(I + p + 12, vsi, vti)));
+        store16(b8c + p, narrow(bin_c4(p), bin_c4(p + 4), bin_c4(p + 8), bin_c4(p + 12)));
+        store16(b8t + p, narrow(bin4(T + p, vst, vtt), bin4(T + p + 4, vst, vtt), bin4(T + p + 8, vst, vtt),
+                                bin4(T + p + 12, vst, vtt)));
+      }
+    } else {
+      for (; p + 4 <= n; p += 4) {
+        const __m128i bi = bin4(I + p, vsi, vti), bt = bin4(T + p, vst, vtt), bc = bin_c4(p);
+        const __m128i lo = _mm_or_si128(bi, _mm_slli_epi32(bc, 16));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p), _mm_unpacklo_epi32(lo, bt));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bins + p + 2), _mm_unpackhi_epi32(lo, bt));
+      }
     }
   }
 #endif
@@ -152,26 +231,15 @@ void CueHistograms::prepare(const LineWindow& window) {
     const auto bt = static_cast<std::uint32_t>(static_cast<int>(clampf(T[p] * st, top_t)));
     const auto bc = static_cast<std::uint32_t>(static_cast<int>(clampf(R[p] * sc, top_c)) * nc +
                                                static_cast<int>(clampf(G[p] * sc, top_c)));
-    bins[p] = (static_cast<std::uint64_t>(bt) << 32) | (bc << 16) | bi;
+    if (bytes) {
+      b8i[p] = static_cast<std::uint8_t>(bi);
+      b8c[p] = static_cast<std::uint8_t>(bc);
+      b8t[p] = static_cast<std::uint8_t>(bt);
+    } else {
+      bins[p] = (static_cast<std::uint64_t>(bt) << 32) | (bc << 16) | bi;
+    }
   }
-  float* __restrict vals = values_.data();
-  p = 0;
-#if defined(__SSE4_1__)
-  for (; p + 4 <= n; p += 4) {
-    __m128 a = _mm_loadu_ps(I + p), b = _mm_loadu_ps(R + p), c = _mm_loadu_ps(G + p), d = _mm_loadu_ps(T + p);
-    _MM_TRANSPOSE4_PS(a, b, c, d);
-    _mm_storeu_ps(vals + 4 * p, a);
-    _mm_storeu_ps(vals + 4 * p + 4, b);
-    _mm_storeu_ps(vals + 4 * p + 8, c);
-    _mm_storeu_ps(vals + 4 * p + 12, d);
-  }
-#endif
-  for (; p < n; ++p) {
-    vals[4 * p] = I[p];
-    vals[4 * p + 1] = R[p];
-    vals[4 * p + 2] = G[p];
-    vals[4 * p + 3] = T[p];
-  }
+  planes_ = {I, R, G, T};
 }
 
 IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_begin, int col_end) {
@@ -181,14 +249,35 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   col_end = std::min(col_end, g.cols);
   if (row < 0 || row >= g.rows || col_end <= col_begin) return out;
   const int p0 = row * g.cols + col_begin, p1 = row * g.cols + col_end;
+  return interval_span(p0, p1);
+}
+
+IntervalCues CueHistograms::interval_span(int p0, int p1) {
+#if defined(__SSE4_1__)
+  if (byte_bins_ && p1 - p0 <= 16) return interval_short(p0, p1 - p0);
+#endif
+  return interval_histogram(p0, p1);
+}
+
+IntervalCues CueHistograms::interval_histogram(int p0, int p1) {
+  IntervalCues out;
   // Pass 1: counts only, tracking each mode (the first bin to reach the top count wins ties).
   // Keeping sums out of this loop shortens its store-to-load chains (neighbouring pixels mostly
   // share a bin); two copies of each histogram, one for even and one for odd pixels (element
   // 2 b and 2 b + 1), halve them again: a pixel's count is the sum of both copies, and the
   // increment of one copy no longer waits for the previous pixel's store.
-  const std::uint64_t* bins = bins_.data();
-  int best_i = static_cast<int>(bins[p0] & 0xFFFF), best_c = static_cast<int>((bins[p0] >> 16) & 0xFFFF),
-      best_t = static_cast<int>(bins[p0] >> 32);
+  // The three bins of a pixel packed as in bins_, read from the byte planes when those are used.
+  const std::uint64_t* const words = bins_.data();
+  const std::uint8_t* const b8i = bin8_i_.data();
+  const std::uint8_t* const b8c = bin8_c_.data();
+  const std::uint8_t* const b8t = bin8_t_.data();
+  const bool bytes = byte_bins_;
+  auto word = [&](int p) -> std::uint64_t {
+    if (!bytes) return words[p];
+    return b8i[p] | (std::uint64_t{b8c[p]} << 16) | (std::uint64_t{b8t[p]} << 32);
+  };
+  int best_i = static_cast<int>(word(p0) & 0xFFFF), best_c = static_cast<int>((word(p0) >> 16) & 0xFFFF),
+      best_t = static_cast<int>(word(p0) >> 32);
   int top_i = 0, top_c = 0, top_t = 0;
   std::uint16_t* const hist_i = count_i_.data();
   std::uint16_t* const hist_c = count_c_.data();
@@ -208,28 +297,31 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   };
   int p = p0;
   for (; p + 2 <= p1; p += 2) {
-    step(bins[p], 0);
-    step(bins[p + 1], 1);
+    step(word(p), 0);
+    step(word(p + 1), 1);
   }
-  if (p < p1) step(bins[p], 0);
+  if (p < p1) step(word(p), 0);
   // Pass 2: clear the touched bins and sum the samples of each modal bin (branch-free), so the
   // mode is refined to the mean of its bin (finer than the bin width).
   std::uint16_t* __restrict ci_ = count_i_.data();
   std::uint16_t* __restrict cc_ = count_c_.data();
   std::uint16_t* __restrict ct_ = count_t_.data();
-  const float* vals = values_.data();
+  const float* const I = planes_[0];
+  const float* const R = planes_[1];
+  const float* const G = planes_[2];
+  const float* const T = planes_[3];
   auto clear2 = [](std::uint16_t* h) { const std::uint32_t z = 0; std::memcpy(h, &z, sizeof z); };
 #if defined(__SSE4_1__)
   // Lanes (I, R, G, T) against the modal bins (intensity, chroma, chroma, texture).
   const __m128i best = _mm_setr_epi32(best_i, best_c, best_c, best_t);
   auto masked = [&](int p) {
-    const std::uint64_t q = bins[p];
+    const std::uint64_t q = word(p);
     clear2(ci_ + 2 * (q & 0xFFFF));
     clear2(cc_ + 2 * ((q >> 16) & 0xFFFF));
     clear2(ct_ + 2 * (q >> 32));
     const __m128i b = _mm_shuffle_epi32(_mm_cvtepu16_epi32(_mm_cvtsi64_si128(static_cast<long long>(q))), 0x94);
     const __m128 hit = _mm_castsi128_ps(_mm_cmpeq_epi32(b, best));
-    return _mm_and_ps(hit, _mm_loadu_ps(vals + 4 * static_cast<std::size_t>(p)));
+    return _mm_and_ps(hit, _mm_setr_ps(I[p], R[p], G[p], T[p]));
   };
   // One add chain in pixel order, so the sums are those of the scalar loop.
   __m128 sum = _mm_setzero_ps();
@@ -240,15 +332,15 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
 #else
   float si = 0, sr = 0, sg = 0, st = 0;
   for (int p = p0; p < p1; ++p) {
-    const std::uint64_t q = bins[p];
+    const std::uint64_t q = word(p);
     const int bi = static_cast<int>(q & 0xFFFF), bc = static_cast<int>((q >> 16) & 0xFFFF), bt = static_cast<int>(q >> 32);
     clear2(ci_ + 2 * bi);
     clear2(cc_ + 2 * bc);
     clear2(ct_ + 2 * bt);
-    si += bi == best_i ? vals[4 * p] : 0.0f;
-    sr += bc == best_c ? vals[4 * p + 1] : 0.0f;
-    sg += bc == best_c ? vals[4 * p + 2] : 0.0f;
-    st += bt == best_t ? vals[4 * p + 3] : 0.0f;
+    si += bi == best_i ? I[p] : 0.0f;
+    sr += bc == best_c ? R[p] : 0.0f;
+    sg += bc == best_c ? G[p] : 0.0f;
+    st += bt == best_t ? T[p] : 0.0f;
   }
 #endif
   out.value[0] = si / static_cast<float>(top_i);
@@ -259,25 +351,83 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   return out;
 }
 
+#if defined(__SSE4_1__)
+IntervalCues CueHistograms::interval_short(int p0, int n) const {
+  // The same modes, tie rule and modal-bin sums as interval_histogram(), for n <= 16 pixels.
+  auto load = [p0](const std::vector<std::uint8_t>& plane) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(plane.data() + p0));
+  };
+  const __m128i b[3] = {load(bin8_i_), load(bin8_c_), load(bin8_t_)};
+  __m128i count[3];
+  prefix_counts(b, n, count, std::make_integer_sequence<int, 15>{});
+  const __m128i valid = lanes_below(n);
+  int top_i = 0, top_c = 0, top_t = 0;
+  const __m128i hit_i = modal_lanes(b[0], count[0], valid, top_i);
+  const __m128i hit_c = modal_lanes(b[1], count[1], valid, top_c);
+  const __m128i hit_t = modal_lanes(b[2], count[2], valid, top_t);
+  // Per pixel a 4-byte mask (I, R, G, T) = (hit_i, hit_c, hit_c, hit_t), four pixels per register.
+  const __m128i ic_lo = _mm_unpacklo_epi8(hit_i, hit_c), ct_lo = _mm_unpacklo_epi8(hit_c, hit_t);
+  const __m128i ic_hi = _mm_unpackhi_epi8(hit_i, hit_c), ct_hi = _mm_unpackhi_epi8(hit_c, hit_t);
+  const __m128i quads[4] = {_mm_unpacklo_epi16(ic_lo, ct_lo), _mm_unpackhi_epi16(ic_lo, ct_lo),
+                            _mm_unpacklo_epi16(ic_hi, ct_hi), _mm_unpackhi_epi16(ic_hi, ct_hi)};
+  // One add chain in pixel order, as in interval_histogram(); the lanes past n add +0. Four
+  // pixels of the four planes are transposed to four (I, R, G, T) vectors (the planes are
+  // padded, so the loads past the row's end stay inside them).
+  __m128 sum = _mm_setzero_ps();
+  auto add = [&](__m128i mask8, __m128 v) {
+    sum = _mm_add_ps(sum, _mm_and_ps(_mm_castsi128_ps(_mm_cvtepi8_epi32(mask8)), v));
+  };
+  for (int q = 0; 4 * q < n; ++q) {
+    const int p = p0 + 4 * q;
+    __m128 v0 = _mm_loadu_ps(planes_[0] + p), v1 = _mm_loadu_ps(planes_[1] + p);
+    __m128 v2 = _mm_loadu_ps(planes_[2] + p), v3 = _mm_loadu_ps(planes_[3] + p);
+    _MM_TRANSPOSE4_PS(v0, v1, v2, v3);  // v_k: pixel p + k
+    add(quads[q], v0);
+    add(_mm_srli_si128(quads[q], 4), v1);
+    add(_mm_srli_si128(quads[q], 8), v2);
+    add(_mm_srli_si128(quads[q], 12), v3);
+  }
+  alignas(16) float s4[4];
+  _mm_store_ps(s4, sum);
+  IntervalCues out;
+  out.value[0] = s4[0] / static_cast<float>(top_i);
+  out.value[1] = s4[1] / static_cast<float>(top_c);
+  out.value[2] = s4[2] / static_cast<float>(top_c);
+  out.value[3] = s4[3] / static_cast<float>(top_t);
+  out.valid = true;
+  return out;
+}
+#endif
+
 void CueHistograms::intervals(const LineWindow& window, EdgelSet& edgels, std::vector<IntervalCues>& out,
                               bool left_of_edgels, bool right_of_edgels) {
-  out.clear();
   const WindowGeometry& g = window.geometry();
   const int margin = options_.edge_margin_px;
+  // Row r holds edgels [row_begin[r], row_begin[r + 1]) and one interval more; the caller
+  // reserved the capacity, so this resize does not allocate.
+  out.resize(edgels.edgels.size() + static_cast<std::size_t>(std::max(edgels.rows, 0)));
+  IntervalCues* next = out.data();
+  // Columns [lo, hi) of row r: empty spans are invalid, as in interval().
+  auto span = [&](int r, int lo, int hi) {
+    lo = std::max(lo, 0);
+    hi = std::min(hi, g.cols);
+    return hi > lo && r < g.rows ? interval_span(r * g.cols + lo, r * g.cols + hi) : IntervalCues{};
+  };
   for (int r = 0; r < edgels.rows; ++r) {
     int lo = 0;
     const int b = edgels.row_begin[r], e_end = edgels.row_begin[r + 1];
     for (int e = b; e < e_end; ++e) {
       Edgel& edgel = edgels.edgels[e];
       const int c = static_cast<int>(edgel.col + 0.5f);  // col >= 2: truncation rounds
-      edgel.left_interval = static_cast<int>(out.size());
+      edgel.left_interval = static_cast<int>(next - out.data());
       // Interval e is left of edgel e and right of edgel e - 1: skip it when neither side is used.
       const bool needed = left_of_edgels || (right_of_edgels && e > b);
-      out.push_back(needed ? interval(window, r, lo, c - margin) : IntervalCues{});
+      *next++ = needed ? span(r, lo, c - margin) : IntervalCues{};
       lo = c + margin + 1;
     }
-    out.push_back(right_of_edgels && e_end > b ? interval(window, r, lo, g.cols) : IntervalCues{});
+    *next++ = right_of_edgels && e_end > b ? span(r, lo, g.cols) : IntervalCues{};
   }
+  out.resize(static_cast<std::size_t>(next - out.data()));
 }
 
 }  // namespace epichead::vision

@@ -28,7 +28,8 @@ LineWindow::LineWindow(const WindowOptions& options) : options_(options) {
   options_.width_px = std::clamp(options_.width_px, 8, kMaxWindowWidth);
   options_.max_rows = std::max(options_.max_rows, 2);
   capacity_ = options_.width_px * options_.max_rows;
-  planes_.assign(static_cast<std::size_t>(kCueChannels) * capacity_, 0.0f);
+  // Padded by 4 floats so that a reader may load 4 floats from any element (see plane()).
+  planes_.assign(static_cast<std::size_t>(kCueChannels) * capacity_ + 4, 0.0f);
 }
 
 bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, const Eigen::Vector2d& b_px) {
@@ -92,9 +93,10 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
       const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
       const __m128i vw = _mm_set1_epi32(w);
       alignas(16) std::int32_t off[4];
-      for (; c + 4 <= g.cols; c += 4) {
-        const __m128 vc = _mm_setr_ps(static_cast<float>(c), static_cast<float>(c + 1),
-                                      static_cast<float>(c + 2), static_cast<float>(c + 3));
+      // Column numbers as floats, stepped by 4 (exact: small integers).
+      __m128 vc = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f);
+      const __m128 four = _mm_set1_ps(4.0f);
+      for (; c + 4 <= g.cols; c += 4, vc = _mm_add_ps(vc, four)) {
         __m128 x = _mm_add_ps(vx0, _mm_mul_ps(vc, vax)), y = _mm_add_ps(vy0, _mm_mul_ps(vc, vay));
         if (!inside) {
           x = _mm_min_ps(_mm_max_ps(x, zero), vxmax);

@@ -10,13 +10,24 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
+EpicMode epic_mode(TrackMode mode) {
+  switch (mode) {
+    case TrackMode::Gradient: return EpicMode::Gradient;
+    case TrackMode::Epic: return EpicMode::EpicSingle;
+    case TrackMode::EpicValidation: return EpicMode::Epic;
+  }
+  return EpicMode::Epic;
+}
+
+EllipseTrackerOptions ellipse_options(const ModelTrackerOptions& o) {
+  EllipseTrackerOptions e = o.ellipses;
+  e.mode = epic_mode(o.mode);
+  return e;
+}
+
 LineTrackerOptions line_options(const ModelTrackerOptions& o) {
   LineTrackerOptions l = o.lines;
-  switch (o.mode) {
-    case TrackMode::Gradient: l.mode = EpicMode::Gradient; break;
-    case TrackMode::Epic: l.mode = EpicMode::EpicSingle; break;
-    case TrackMode::EpicValidation: l.mode = EpicMode::Epic; break;
-  }
+  l.mode = epic_mode(o.mode);
   return l;
 }
 
@@ -64,6 +75,7 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
       options_(options),
       visibility_(model, camera, options.visibility),
       lines_(line_options(options)),
+      ellipses_(ellipse_options(options)),
       validator_(model, options.validation),
       estimator_(camera, options.pose) {
   const std::size_t edges = model.edges.size();
@@ -78,12 +90,20 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
     obs.edgels_px.reserve(static_cast<std::size_t>(options.lines.window.max_rows) * 4);
   }
   problem_.points.reserve(model.vertices.size());
+  // One slot per model circle, like the lines (a slot without points is ignored).
+  problem_.ellipses.resize(model.circles.size());
+  for (std::size_t c = 0; c < model.circles.size(); ++c) {
+    problem_.ellipses[c].feature = static_cast<int>(c);
+    problem_.ellipses[c].circle = model.circles[c];
+    problem_.ellipses[c].points_px.reserve(static_cast<std::size_t>(options.ellipses.lines) * 4);
+  }
   kept_last_.assign(edges, kNotVisible);
   kept_now_.assign(edges, kNotVisible);
 }
 
 void ModelTracker::reset() {
   lines_.reset();
+  ellipses_.reset();
   std::fill(kept_last_.begin(), kept_last_.end(), kNotVisible);
   was_lost_ = false;
 }
@@ -135,6 +155,22 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
     out.visible += f.visible;
     out.found += f.visible && f.selected >= 0;
   }
+  out.ellipses_visible = out.ellipses_found = out.ellipses_weak = 0;
+  for (EllipseObservation& obs : problem_.ellipses) obs.points_px.clear();
+  if (!visible_.ellipses.empty()) {
+    t = Clock::now();
+    ellipses_.track(image, visible_, WindowPlacement::Projection);
+    for (const EllipseFeature& f : ellipses_.features()) {
+      out.ellipses_visible += f.visible;
+      if (!f.visible || !f.found || f.circle < 0 || f.circle >= static_cast<int>(problem_.ellipses.size())) continue;
+      EllipseObservation& obs = problem_.ellipses[static_cast<std::size_t>(f.circle)];
+      if (ellipses_.observation(f, model_->circles[static_cast<std::size_t>(f.circle)], obs)) {
+        ++out.ellipses_found;
+        out.ellipses_weak += f.weak;
+      }
+    }
+    out.times.epic_ms += ms_since(t);
+  }
 
   t = Clock::now();
   if (options_.mode == TrackMode::EpicValidation) {
@@ -152,8 +188,8 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
     if (f.visible && static_cast<std::size_t>(f.edge) < kept_now_.size()) kept_now_[static_cast<std::size_t>(f.edge)] = kMissed;
 
   TrackReason reasons = TrackReason::None;
-  if (out.visible < 3) reasons = reasons | TrackReason::NotVisible;
-  if (out.found < options_.min_features) reasons = reasons | TrackReason::FewFeatures;
+  if (out.visible + out.ellipses_visible < 2) reasons = reasons | TrackReason::NotVisible;
+  if (out.found + 2 * out.ellipses_found < options_.min_features) reasons = reasons | TrackReason::FewFeatures;
   bool pose_ok = reasons == TrackReason::None;
   out.inliers = out.rejected = 0;
   if (pose_ok) {
@@ -193,10 +229,14 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
     out.cam_T_obj = pose_.cam_T_obj;
     out.covariance = pose_.covariance;
     out.scale_px = pose_.scale_px;
-    if (out.inliers < 3) {
+    int ellipse_inliers = 0;
+    const std::size_t first_ellipse = problem_.lines.size() + problem_.points.size();
+    for (std::size_t k = first_ellipse; k < first_ellipse + problem_.ellipses.size() && k < pose_.residuals.size(); ++k)
+      ellipse_inliers += problem_.ellipses[k - first_ellipse].points_px.size() >= 5 && pose_.residuals[k].inlier;
+    if (out.inliers + 2 * ellipse_inliers < 3) {
       reasons = reasons | TrackReason::FewInliers;
       pose_ok = false;
-    } else if (out.inliers < options_.min_inlier_ratio * out.found) {
+    } else if (out.inliers + 2 * ellipse_inliers < options_.min_inlier_ratio * (out.found + 2 * out.ellipses_found)) {
       reasons = reasons | TrackReason::FewInliers;
     }
     if (pose_ok && pose_.scale_px > options_.max_scale_px) {

@@ -1,6 +1,7 @@
 #pragma once
 // A simulator scenario: which scene, how the camera moves, lighting, noise, occluders, IMU and
 // how many frames, read from a small line-based text file (format: sim/scenarios/README.md).
+// For closed-loop runs (sim_world.h) also bus timing, head dynamics and injected faults.
 #include <cstdint>
 #include <expected>
 #include <optional>
@@ -9,6 +10,9 @@
 
 #include <Eigen/Core>
 
+#include "epichead/sim/bus_timing.h"
+#include "epichead/sim/fault_plan.h"
+#include "epichead/sim/head_dynamics.h"
 #include "epichead/sim/head_mount.h"
 #include "epichead/sim/imu_model.h"
 #include "epichead/sim/trajectory.h"
@@ -57,6 +61,12 @@ struct Scenario {
   double aim_t_s = 0;                        // body pose at which the fixed head angles are aimed
   std::optional<Eigen::Vector2d> head_deg;   // explicit fixed pan, tilt (overrides aim)
   ImuParams imu;
+
+  // Closed loop (sim_world.h); ignored by write_sequence.
+  BusTiming bus;
+  HeadDynamics head_dynamics;
+  double camera_latency_s = 0.010;   // end of exposure -> frame available to the host
+  std::vector<FaultWindow> faults;   // in file order
 
   double frame_time_s(int frame) const { return first_frame_s + frame / fps; }
   double light_gain(double t_s) const;

@@ -70,14 +70,22 @@ class CueHistograms {
   CueOptions options_;
   int capacity_ = 0;
   // Per pixel, the three bins packed in one word (one load per pixel in the interval loops):
-  // bits 0..15 intensity, 16..31 the 2-D chroma bin, 32..47 texture.
+  // bits 0..15 intensity, 16..31 the 2-D chroma bin, 32..47 texture. Used when a bin index
+  // does not fit a byte (chroma_bins > 16); else the byte planes below hold the bins.
   std::vector<std::uint64_t> bins_;
-  // Per pixel the four channel values interleaved (I, R, G, T), so that the modal-bin sums of
-  // an interval add one 4-lane vector per pixel.
-  std::vector<float> values_;
+  // The bins as one byte per pixel and channel (intensity, 2-D chroma, texture), padded by
+  // 16 bytes: an interval of up to 16 pixels is one register per channel and its mode is found
+  // without a histogram (interval_short); longer ones run the histogram loop over these bytes.
+  bool byte_bins_ = false;
+  std::vector<std::uint8_t> bin8_i_, bin8_c_, bin8_t_;
+  // The planes of the window given to prepare() (I, R, G, T): the modal-bin sums read them.
+  std::array<const float*, kCueChannels> planes_{};
   // Histogram counts, all zero between calls (cleared by revisiting the interval's pixels); two
   // interleaved copies (element 2 b for even pixels, 2 b + 1 for odd) break the counting chains.
   std::vector<std::uint16_t> count_i_, count_c_, count_t_;
+  IntervalCues interval_span(int p0, int p1);       // pixels [p0, p1) of one row, p1 > p0
+  IntervalCues interval_histogram(int p0, int p1);  // any length: counts, mode, modal sums
+  IntervalCues interval_short(int p0, int n) const; // n <= 16 with byte bins, SSE4.1, same result
 };
 
 }  // namespace epichead::vision

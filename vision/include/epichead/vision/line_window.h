@@ -46,7 +46,8 @@ class LineWindow {
   const WindowOptions& options() const { return options_; }
   const WindowGeometry& geometry() const { return geometry_; }
   bool colour() const { return colour_; }
-  // Plane of one channel; element (row, col) at [row * cols + col].
+  // Plane of one channel; element (row, col) at [row * cols + col]. Four floats may be loaded
+  // from any element (the planes are padded), so SIMD readers need no scalar tail.
   const float* plane(CueChannel c) const { return planes_.data() + static_cast<int>(c) * capacity_; }
   float* plane(CueChannel c) { return planes_.data() + static_cast<int>(c) * capacity_; }
 

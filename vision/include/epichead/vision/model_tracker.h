@@ -14,6 +14,7 @@
 
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
+#include "epichead/vision/ellipse_tracker.h"
 #include "epichead/vision/line_tracker.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/topology_validator.h"
@@ -56,10 +57,14 @@ std::string to_string(TrackReason reasons);
 struct ModelTrackerOptions {
   TrackMode mode = TrackMode::EpicValidation;
   LineTrackerOptions lines;
+  // Model circles: tracker lines, ellipse RANSAC and arcs (ellipse_tracker.h). The rim side is
+  // not known from a CAO circle, so both sides vote by default.
+  EllipseTrackerOptions ellipses = [] { EllipseTrackerOptions e; e.side = RimSide::Both; return e; }();
   ValidationOptions validation;
   PoseOptions pose;
   VisibilityOptions visibility;
-  int min_features = 4;            // lines needed for a pose (three fix it; one spare against a bad one)
+  int min_features = 4;            // lines needed for a pose (three fix it; one spare against a bad one);
+                                   // a found ellipse counts as two lines
   double min_inlier_ratio = 0.5;   // below this share of found lines explained: degraded
   double max_scale_px = 2.5;       // robust residual scale above this: degraded (blur, partial fits);
                                    // above twice this the pose explains nothing: lost
@@ -86,6 +91,7 @@ struct FrameReport {
   int pose_iterations = 0;         // Levenberg-Marquardt iterations over all rejection rounds
   int visible = 0;                 // line windows placed
   int found = 0;                   // windows with at least one candidate
+  int ellipses_visible = 0, ellipses_found = 0, ellipses_weak = 0;  // model circles (weak: arc < 180 deg)
   int validated_changed = 0;       // features where validation chose another than RANSAC's best
   int junctions = 0;               // junction points given to the pose
   int inliers = 0, rejected = 0;   // found lines the pose kept / rejected as outliers
@@ -108,6 +114,7 @@ class ModelTracker {
   // Inspection (for overlays and tests): the line features of the last frame, the validation
   // result and the pose result.
   const LineTracker& lines() const { return lines_; }
+  const EllipseTracker& ellipses() const { return ellipses_; }
   const ValidationResult& validation() const { return validation_; }
   const PoseResult& pose() const { return pose_; }
   const VisibleModel& visible() const { return visible_; }
@@ -123,6 +130,7 @@ class ModelTracker {
   ModelTrackerOptions options_;
   Visibility visibility_;
   LineTracker lines_;
+  EllipseTracker ellipses_;
   TopologyValidator validator_;
   PoseEstimator estimator_;
   VisibleModel visible_;

@@ -1,0 +1,19 @@
+#pragma once
+// The vision update: a measured cam_T_obj with the covariance of its left perturbation
+// (translation, rotation), exactly what vision::PoseEstimator returns. Mahalanobis-gated.
+#include "epichead/fusion/lie.h"
+#include "epichead/fusion/nav_state.h"
+
+namespace epichead::fusion {
+
+struct PoseUpdateResult {
+  bool applied = false;     // false: gated (state untouched)
+  double mahalanobis2 = 0;  // r' S^-1 r, the normalised innovation squared (chi-square, 6 dof)
+};
+
+// Innovation r = se3_log(measured * estimate^-1); applied when r' S^-1 r <= gate_chi2.
+// Joseph-form covariance update. `cov` must be symmetric positive definite (checked by the caller).
+PoseUpdateResult update_pose(NavState& x, ErrorCovariance& P, const Eigen::Isometry3d& measured_cam_T_obj,
+                             const Matrix6d& cov, double gate_chi2);
+
+}  // namespace epichead::fusion

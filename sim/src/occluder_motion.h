@@ -1,0 +1,17 @@
+#pragma once
+// Occluder poses at a time: the scenario's keys when an occluder has any, else the scene's
+// default path. The same rule as simulate_sequence.cpp's (which keeps a private copy that the
+// lead may switch to this helper).
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "epichead/sim/scenario.h"
+#include "epichead/sim/scene.h"
+
+namespace epichead::sim {
+
+// Fills `out` (one pose per scene occluder); `out` keeps its capacity, so no allocation once sized.
+void occluder_poses_at(const Scene& scene, const Scenario& scenario, double t_s, std::vector<Eigen::Isometry3d>& out);
+
+}  // namespace epichead::sim
