@@ -1,15 +1,13 @@
 #!/usr/bin/env bash
-# The main job run by `./dev demo`. Until the closed-loop simulator lands (issue 9) it is the
-# projection demo: the teabox model drawn over the first frame of the real teabox video.
+# The main job run by `./dev demo`: the closed-loop hardware-in-the-loop run of the onboard loop
+# (tracker, Kalman predictor, head controller) against the simulator's walking robot, then a
+# replay of the CAN log it recorded.
 set -euo pipefail
 bin="$1"
+shift || true
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-seq="$here/../shared/data/teabox"
 out="$here/out/demo"
 mkdir -p "$out"
-if [[ ! -d "$seq" ]]; then
-  echo "demo: $seq not found (the shared data sits beside the checkout)" >&2
-  exit 1
-fi
-"$bin" project "$seq" --frame 0 --out "$out/teabox_overlay.png"
-echo "demo: wrote $out/teabox_overlay.png"
+"$bin" sim-run mockup_walk --out "$out" "$@"
+"$bin" replay "$out/bus.log" --plot "$out/replay" > "$out/replay.txt"
+echo "demo: summary $out/summary.json, plots $out/sim_run.png and $out/replay/, replay report $out/replay.txt"

@@ -1,0 +1,102 @@
+#pragma once
+// The onboard program's loop: camera frames, IMU samples and head state come in through the hw
+// ports, head commands go out through them. Per 1 ms tick: drain the bus (IMU pairs -> the
+// Kalman predictor, head state, time-sync replies, heartbeats), take a new camera frame if one is
+// ready (predicted pose at its exposure time -> tracker -> vision update -> target for fixation),
+// step the head controller and send its command, send a time-sync request every
+// time_sync_period_s. Everything received and sent is recorded in a candump log; a JSON line per
+// diagnostics period (and per controller event) goes to the diagnostics stream.
+//
+// The same code runs on the robot (Linux drivers, wall-clock waits) and in the closed-loop
+// simulator (simulated ports, waits that advance simulated time). Vision runs inline; its result
+// is published `processing_s` after the frame was taken from the camera when that is set (the
+// simulator's modelled processing time, so runs are deterministic), else when it is done.
+#include <cstdint>
+#include <cstdio>
+#include <expected>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "epichead/firmware_iface/candump_writer.h"
+#include "epichead/fusion/predictor.h"
+#include "epichead/head/device_clock_sync.h"
+#include "epichead/head/head_controller.h"
+#include "epichead/head/imu_frame_assembler.h"
+#include "epichead/hw/camera_port.h"
+#include "epichead/hw/can_bus.h"
+#include "epichead/hw/clock.h"
+#include "epichead/vision/model_tracker.h"
+
+namespace epichead::head {
+
+struct OnboardPorts {
+  hw::Clock* clock = nullptr;
+  hw::CanBus* bus = nullptr;
+  hw::CameraPort* camera = nullptr;
+  // Blocks (robot) or advances simulated time (simulator) until the clock reads t_s.
+  std::function<std::expected<void, std::string>(double t_s)> wait_until;
+};
+
+struct OnboardOptions {
+  double control_rate_hz = 1000;
+  double time_sync_period_s = 0.1;
+  double diagnostics_period_s = 0.1;
+  double processing_s = -1;            // >= 0: vision results are published this long after the frame arrived
+  ControlMode mode = ControlMode::Fixate;
+  vision::ModelTrackerOptions tracker;
+  fusion::PredictorOptions predictor;  // the IMU is mapped to the controller clock here: its offset is unused
+  HeadControllerOptions controller;
+  std::string candump_path;            // empty: no recording
+  std::string candump_iface = "can0";
+  std::string diagnostics_path;        // JSON lines; empty: none
+};
+
+// One tracked frame, given to the caller's hook (overlays, ground-truth comparison).
+struct TrackedFrame {
+  std::uint64_t index = 0;
+  double exposure_t_s = 0, published_t_s = 0;
+  Eigen::Isometry3d predicted_cam_T_obj = Eigen::Isometry3d::Identity();
+  const vision::FrameReport* report = nullptr;
+  const vision::ModelTracker* tracker = nullptr;
+  const hw::CameraFrame* image = nullptr;
+};
+using FrameHook = std::function<void(const TrackedFrame&)>;
+
+struct OnboardSummary {
+  std::uint64_t ticks = 0, late_ticks = 0;       // control ticks; ticks started more than a period late
+  std::uint64_t frames = 0, tracked = 0, lost = 0;
+  std::uint64_t imu_samples = 0, imu_rejected = 0;
+  std::uint64_t commands_sent = 0, commands_withheld = 0, send_failures = 0;
+  std::uint64_t bus_errors = 0, frames_logged = 0, unknown_frames = 0, undecodable_frames = 0;
+  std::uint64_t camera_lost = 0, unreadable_frames = 0;  // device gone; frames of a format the tracker cannot read
+  double track_ms_median = 0, track_ms_p99 = 0;                 // wall time of the tracking step
+  double exposure_to_command_ms_median = 0, exposure_to_command_ms_max = 0;  // program clock
+  double tick_ms_median = 0, tick_ms_p99 = 0;                   // wall time of one control tick's work
+  HeadCounters controller;
+  ImuAssemblyCounters imu_assembly;
+  fusion::PredictorCounters predictor;
+};
+
+class OnboardLoop {
+ public:
+  static std::expected<std::unique_ptr<OnboardLoop>, std::string> create(const vision::CadModel& model,
+                                                                          const vision::Camera& camera,
+                                                                          const OnboardOptions& options,
+                                                                          const OnboardPorts& ports);
+  ~OnboardLoop();
+  // Runs until the clock reads until_s (or a port fails for good). Frames are handed to `hook`.
+  std::expected<OnboardSummary, std::string> run(double until_s, const FrameHook& hook = {});
+  // The pose tracking starts from (init.csv on the robot, the scenario's start in the simulator).
+  void set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_obj);
+
+ private:
+  struct Impl;
+  explicit OnboardLoop(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace epichead::head

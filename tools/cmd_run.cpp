@@ -1,0 +1,149 @@
+// `epichead run --config FILE [--seconds S]`: the onboard loop on real devices: a V4L2 camera, a
+// SocketCAN bus carrying the IMU and the head, the monotonic clock. The configuration is JSON:
+//
+//   { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
+//     "init_pose": "teabox/init.csv",              // where tracking starts (cMo)
+//     "camera": { "device": "/dev/video0", "width": 640, "height": 480 },
+//     "can": { "interface": "can0" },
+//     "mode": "fixate",                            // fixate | stabilise | hold
+//     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
+//
+// Relative paths are taken from the configuration file's folder. Every key but the three files
+// has the default shown.
+#include <CLI/CLI.hpp>
+
+#include <time.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "command.h"
+#include "epichead/head/onboard_loop.h"
+#include "epichead/hw/clock.h"
+#include "epichead/hw/socketcan_bus.h"
+#include "epichead/hw/v4l2_camera.h"
+#include "epichead/vision/camera.h"
+#include "epichead/vision/cao_model.h"
+#include "epichead/vision/stamped_pose.h"
+
+namespace epichead::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunConfig {
+  std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
+  hw::V4l2CameraOptions camera;
+  hw::SocketCanOptions can;
+};
+
+std::expected<RunConfig, std::string> read_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::unexpected(path + ": cannot open");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    return std::unexpected(path + ": not valid JSON: " + e.what());
+  }
+  const fs::path base = fs::path(path).parent_path();
+  auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
+  RunConfig c;
+  try {
+    for (const char* key : {"model", "camera_calibration", "init_pose"})
+      if (!j.contains(key) || !j[key].is_string()) return std::unexpected(path + ": missing string field '" + key + "'");
+    c.model = resolve(j["model"].get<std::string>());
+    c.calibration = resolve(j["camera_calibration"].get<std::string>());
+    c.init_pose = resolve(j["init_pose"].get<std::string>());
+    c.out = resolve(j.value("out", c.out));
+    c.mode = j.value("mode", c.mode);
+    if (j.contains("camera")) {
+      const auto& cam = j["camera"];
+      c.camera.device = cam.value("device", c.camera.device);
+      c.camera.width = cam.value("width", c.camera.width);
+      c.camera.height = cam.value("height", c.camera.height);
+    }
+    if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
+  } catch (const nlohmann::json::exception& e) {
+    return std::unexpected(path + ": wrong type: " + e.what());
+  }
+  return c;
+}
+
+int run_onboard(const std::string& config_path, double seconds) {
+  const char* cmd = "run";
+  auto config = read_config(config_path);
+  if (!config) return fail(cmd, config.error());
+  static const std::map<std::string, head::ControlMode> modes{
+      {"fixate", head::ControlMode::Fixate}, {"stabilise", head::ControlMode::Stabilise}, {"hold", head::ControlMode::Hold}};
+  const auto mode = modes.find(config->mode);
+  if (mode == modes.end()) return fail(cmd, config_path + ": mode must be fixate, stabilise or hold");
+  auto model = vision::load_cao(config->model);
+  if (!model) return fail(cmd, model.error());
+  auto camera_model = vision::Camera::load(config->calibration);
+  if (!camera_model) return fail(cmd, camera_model.error());
+  auto init = vision::read_pose_csv(config->init_pose);
+  if (!init) return fail(cmd, init.error());
+  if (init->empty()) return fail(cmd, config->init_pose + ": no pose");
+  std::error_code ec;
+  fs::create_directories(config->out, ec);
+  if (ec) return fail(cmd, "cannot create " + config->out + ": " + ec.message());
+
+  auto bus = hw::SocketCanBus::open(config->can);
+  if (!bus) return fail(cmd, bus.error());
+  auto camera = hw::V4l2Camera::open(config->camera);
+  if (!camera) return fail(cmd, camera.error());
+  hw::MonotonicClock clock;
+  head::OnboardPorts ports;
+  ports.clock = &clock;
+  ports.bus = bus->get();
+  ports.camera = camera->get();
+  ports.wait_until = [&clock](double t_s) -> std::expected<void, std::string> {
+    // Absolute sleep on the monotonic clock: a late wake-up does not shift later ticks.
+    const double wait = t_s - clock.now_s();
+    if (wait <= 0) return {};
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    const double target = static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec) + wait;
+    ts.tv_sec = static_cast<time_t>(target);
+    ts.tv_nsec = static_cast<long>((target - std::floor(target)) * 1e9);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+    return {};
+  };
+  head::OnboardOptions options;
+  options.mode = mode->second;
+  options.candump_path = (fs::path(config->out) / "bus.log").string();
+  options.candump_iface = config->can.interface;
+  options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();
+  auto loop = head::OnboardLoop::create(*model, *camera_model, options, ports);
+  if (!loop) return fail(cmd, loop.error());
+  (*loop)->set_initial_pose(clock.now_s(), init->front().cam_T_obj);
+  const double until = seconds > 0 ? clock.now_s() + seconds : std::numeric_limits<double>::infinity();
+  auto summary = (*loop)->run(until);
+  if (!summary) return fail(cmd, summary.error());
+  std::printf("run: %llu ticks (%llu late), %llu frames (%llu tracked, %llu lost), %llu IMU samples, %llu commands\n",
+              static_cast<unsigned long long>(summary->ticks), static_cast<unsigned long long>(summary->late_ticks),
+              static_cast<unsigned long long>(summary->frames), static_cast<unsigned long long>(summary->tracked),
+              static_cast<unsigned long long>(summary->lost), static_cast<unsigned long long>(summary->imu_samples),
+              static_cast<unsigned long long>(summary->commands_sent));
+  std::printf("run: wrote %s and %s\n", options.candump_path.c_str(), options.diagnostics_path.c_str());
+  return 0;
+}
+
+const CommandRegistration registration{
+    "run", "The onboard loop on real devices (V4L2 camera, SocketCAN IMU and head)", [](CLI::App& app) {
+      auto config = std::make_shared<std::string>();
+      auto seconds = std::make_shared<double>(0);
+      app.add_option("--config", *config, "JSON configuration (see the top of tools/cmd_run.cpp and the README)")->required();
+      app.add_option("--seconds", *seconds, "Stop after this long (default: run until interrupted)")->check(CLI::Range(0.0, 1e9));
+      return [=]() { return run_onboard(*config, *seconds); };
+    }};
+
+}  // namespace
+}  // namespace epichead::tools

@@ -1,0 +1,277 @@
+// `epichead sim-run SCENARIO --out DIR [--seconds S] [--mode fixate|stabilise|hold] ...`: the
+// onboard loop, closed loop against the simulator's camera, IMU, bus and head (hardware in the
+// loop, simulated time), then the same body motion with the head held fixed for comparison.
+// Prints a summary and writes DIR/summary.json, DIR/bus.log (candump; `epichead replay` reads
+// it), DIR/diagnostics.jsonl, DIR/overlay_NNNNNN.png and DIR/*.png plots.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "command.h"
+#include "plot/line_plot.h"
+#include "epichead/head/onboard_loop.h"
+#include "epichead/head/target_observation.h"
+#include "epichead/sim/scenario.h"
+#include "epichead/sim/scene_library.h"
+#include "epichead/sim/sim_world.h"
+#include "epichead/vision/overlay.h"
+#include "epichead/vision/visibility.h"
+
+namespace epichead::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SimRunArgs {
+  std::string scenario, out, mode = "fixate";
+  double seconds = 0;
+  int every = 30;
+  int downscale = 1;
+  double processing_ms = 5.0;
+  long long seed = -1;
+  double jerk = -1;
+};
+
+// What one closed run measured against the simulator's truth.
+struct RunMeasures {
+  double cam_rate_rms_degps = 0;       // camera angular rate on the image-shifting axes (x, y)
+  double cam_rate_rms_all_degps = 0;   // all three axes
+  double centring_rms_px = 0, centring_max_px = 0;  // target point from the image centre
+  int frames = 0, succeeded = 0;       // tracked frames within 5 cm / 5 deg of the truth
+  plot::Series rate_xy{"camera rate |x,y| (deg/s)", {}, {}};
+  plot::Series pan{"pan (deg)", {}, {}}, tilt{"tilt (deg)", {}, {}};
+  plot::Series centring{"target from centre (px)", {}, {}};
+};
+
+std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& scenario, const SimRunArgs& a,
+                                                          head::ControlMode mode, bool render, const std::string& out,
+                                                          RunMeasures& m) {
+  sim::SimWorldOptions wo;
+  wo.camera = render ? sim::CameraOutput::Render : sim::CameraOutput::Blank;
+  wo.camera_downscale = a.downscale;
+  auto world = sim::SimWorld::create(scenario, wo);
+  if (!world) return std::unexpected(world.error());
+  sim::SimWorld& w = **world;
+  auto model = sim::make_scene_model(scenario.scene);
+  if (!model) return std::unexpected(model.error());
+
+  head::OnboardOptions o;
+  o.mode = mode;
+  o.processing_s = a.processing_ms * 1e-3;
+  if (render) {
+    o.candump_path = (fs::path(out) / "bus.log").string();
+    o.diagnostics_path = (fs::path(out) / "diagnostics.jsonl").string();
+  }
+  // The truth is sampled every millisecond as simulated time advances.
+  double sq_xy = 0, sq_all = 0;
+  long samples = 0;
+  const vision::Camera cam = w.camera_model();
+  Eigen::Vector3d centre_obj = Eigen::Vector3d::Zero();
+  for (const auto& v : model->vertices) centre_obj += v;
+  if (!model->vertices.empty()) centre_obj /= static_cast<double>(model->vertices.size());
+  double sq_centre = 0;
+  long centre_n = 0;
+  head::OnboardPorts ports;
+  ports.clock = &w.clock();
+  ports.bus = &w.bus();
+  ports.camera = &w.camera();
+  ports.wait_until = [&](double t_s) -> std::expected<void, std::string> {
+    if (auto ok = w.advance_to(t_s); !ok) return ok;
+    auto truth = w.truth_at(w.now_s());
+    if (!truth) return std::unexpected(truth.error());
+    const Eigen::Vector3d r = truth->cam_rate_radps * 180.0 / M_PI;
+    sq_xy += r.x() * r.x() + r.y() * r.y();
+    sq_all += r.squaredNorm();
+    ++samples;
+    const Eigen::Vector3d p = truth->cam_T_obj * centre_obj;
+    const Eigen::Vector2d off = head::offset_from_centre_px(cam, p);
+    if (off.allFinite()) {
+      sq_centre += off.squaredNorm();
+      ++centre_n;
+      m.centring_max_px = std::max(m.centring_max_px, off.norm());
+    }
+    if (samples % 10 == 0) {  // plots at 100 Hz
+      m.rate_xy.x.push_back(t_s);
+      m.rate_xy.y.push_back(std::hypot(r.x(), r.y()));
+      m.pan.x.push_back(t_s);
+      m.pan.y.push_back(truth->joints.pan_rad * 180 / M_PI);
+      m.tilt.x.push_back(t_s);
+      m.tilt.y.push_back(truth->joints.tilt_rad * 180 / M_PI);
+      m.centring.x.push_back(t_s);
+      m.centring.y.push_back(off.allFinite() ? off.norm() : std::nan(""));
+    }
+    return {};
+  };
+  auto loop = head::OnboardLoop::create(*model, cam, o, ports);
+  if (!loop) return std::unexpected((*&loop).error());
+  // The tracker starts like `epichead track` from init.csv: the truth perturbed by 1 cm and 1 deg.
+  auto truth0 = w.truth_at(w.now_s());
+  if (!truth0) return std::unexpected(truth0.error());
+  Eigen::Isometry3d init = truth0->cam_T_obj;
+  init.linear() = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d(1, 1, 1).normalized()).toRotationMatrix() * init.linear();
+  init.translation() += Eigen::Vector3d(0.006, -0.006, 0.005);
+  (*loop)->set_initial_pose(w.now_s(), init);
+
+  int overlays = 0;
+  const head::FrameHook hook = [&](const head::TrackedFrame& f) {
+    if (f.report->status != vision::TrackStatus::Lost) {
+      auto truth = w.truth_at(f.exposure_t_s);
+      if (truth) {
+        const Eigen::Isometry3d d = f.report->cam_T_obj * truth->cam_T_obj.inverse();
+        const double rot_deg = Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI;
+        const double t_m = (f.report->cam_T_obj.translation() - truth->cam_T_obj.translation()).norm();
+        m.succeeded += rot_deg <= 5.0 && t_m <= 0.05;
+      }
+    }
+    ++m.frames;
+    if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
+    const hw::CameraFrame& img = *f.image;
+    cv::Mat bgr(img.height, img.width, CV_8UC3, const_cast<std::uint8_t*>(img.data), static_cast<std::size_t>(img.stride_bytes));
+    cv::Mat canvas = bgr.clone();
+    const vision::VisibleModel vis = vision::compute_visibility(*model, cam, f.report->cam_T_obj);
+    vision::draw_visible_model(canvas, vis);
+    char caption[128];
+    std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.report->status),
+                  f.report->inliers, f.report->visible);
+    cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
+    char name[64];
+    std::snprintf(name, sizeof name, "overlay_%06llu.png", static_cast<unsigned long long>(f.index));
+    if (cv::imwrite((fs::path(out) / name).string(), canvas)) ++overlays;
+  };
+  const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
+  auto summary = (*loop)->run(std::min(until, w.horizon_s()), hook);
+  if (!summary) return summary;
+  m.cam_rate_rms_degps = samples ? std::sqrt(sq_xy / static_cast<double>(samples)) : 0;
+  m.cam_rate_rms_all_degps = samples ? std::sqrt(sq_all / static_cast<double>(samples)) : 0;
+  m.centring_rms_px = centre_n ? std::sqrt(sq_centre / static_cast<double>(centre_n)) : 0;
+  return summary;
+}
+
+nlohmann::json summary_json(const head::OnboardSummary& s) {
+  return {{"ticks", s.ticks},
+          {"late_ticks", s.late_ticks},
+          {"frames", s.frames},
+          {"tracked", s.tracked},
+          {"lost", s.lost},
+          {"imu_samples", s.imu_samples},
+          {"imu_rejected", s.imu_rejected},
+          {"commands_sent", s.commands_sent},
+          {"commands_withheld", s.commands_withheld},
+          {"send_failures", s.send_failures},
+          {"bus_errors", s.bus_errors},
+          {"frames_logged", s.frames_logged},
+          {"track_ms_median", s.track_ms_median},
+          {"track_ms_p99", s.track_ms_p99},
+          {"tick_ms_median", s.tick_ms_median},
+          {"tick_ms_p99", s.tick_ms_p99},
+          {"exposure_to_command_ms_median", s.exposure_to_command_ms_median},
+          {"exposure_to_command_ms_max", s.exposure_to_command_ms_max},
+          {"controller", {{"rate_limited", s.controller.rate_limited},
+                          {"accel_limited", s.controller.accel_limited},
+                          {"position_limited", s.controller.position_limited},
+                          {"encode_clipped", s.controller.encode_clipped},
+                          {"events", s.controller.events}}},
+          {"imu_assembly", {{"samples", s.imu_assembly.samples},
+                            {"unpaired", s.imu_assembly.unpaired},
+                            {"unsynced", s.imu_assembly.unsynced},
+                            {"counter_gaps", s.imu_assembly.counter_gaps}}},
+          {"predictor", {{"vision_applied", s.predictor.vision_applied},
+                         {"vision_gated", s.predictor.vision_gated},
+                         {"dropouts", s.predictor.dropouts},
+                         {"reinitialisations", s.predictor.reinitialisations}}}};
+}
+
+int run_sim_run(const SimRunArgs& a) {
+  const char* cmd = "sim-run";
+  static const std::map<std::string, head::ControlMode> modes{
+      {"fixate", head::ControlMode::Fixate}, {"stabilise", head::ControlMode::Stabilise}, {"hold", head::ControlMode::Hold}};
+  const auto mode = modes.find(a.mode);
+  if (mode == modes.end()) return fail(cmd, "--mode must be fixate, stabilise or hold, got '" + a.mode + "'");
+  auto scenario = sim::find_scenario(a.scenario);
+  if (!scenario) return fail(cmd, scenario.error());
+  if (a.seed >= 0) scenario->seed = static_cast<std::uint64_t>(a.seed);
+  if (a.jerk >= 0) scenario->walking.jerk = a.jerk;
+  std::error_code ec;
+  fs::create_directories(a.out, ec);
+  if (ec) return fail(cmd, "cannot create " + a.out + ": " + ec.message());
+
+  RunMeasures closed, fixed;
+  auto run = run_once(*scenario, a, mode->second, true, a.out, closed);
+  if (!run) return fail(cmd, run.error());
+  // The comparison: the same body motion with the head held still (no rendering needed).
+  auto held = run_once(*scenario, a, head::ControlMode::Hold, false, a.out, fixed);
+  if (!held) return fail(cmd, "fixed-head run: " + held.error());
+
+  const double success = closed.frames ? static_cast<double>(closed.succeeded) / closed.frames : 0.0;
+  const double reduction = closed.cam_rate_rms_degps > 0 ? fixed.cam_rate_rms_degps / closed.cam_rate_rms_degps : 0.0;
+  nlohmann::json j{{"scenario", scenario->name},
+                   {"mode", a.mode},
+                   {"seed", scenario->seed},
+                   {"processing_ms", a.processing_ms},
+                   {"tracking_success", success},
+                   {"frames", closed.frames},
+                   {"camera_rate_rms_degps", {{"closed_loop", closed.cam_rate_rms_degps}, {"fixed_head", fixed.cam_rate_rms_degps},
+                                              {"reduction", reduction}, {"axes", "x,y (image-shifting); roll cannot be cancelled"},
+                                              {"closed_loop_all_axes", closed.cam_rate_rms_all_degps},
+                                              {"fixed_head_all_axes", fixed.cam_rate_rms_all_degps}}},
+                   {"centring_px", {{"rms", closed.centring_rms_px}, {"max", closed.centring_max_px},
+                                    {"fixed_head_rms", fixed.centring_rms_px}}},
+                   {"loop", summary_json(*run)}};
+  const std::string summary_path = (fs::path(a.out) / "summary.json").string();
+  std::ofstream(summary_path) << j.dump(1) << '\n';
+
+  plot::Figure fig;
+  fig.title = "sim-run " + scenario->name + " (" + a.mode + ")";
+  plot::Panel rate{"camera angular rate on the image axes", "t (s)", "deg/s", {}};
+  closed.rate_xy.label = "closed loop";
+  fixed.rate_xy.label = "head fixed";
+  rate.series = {fixed.rate_xy, closed.rate_xy};
+  plot::Panel joints{"head joints", "t (s)", "deg", {closed.pan, closed.tilt}};
+  plot::Panel centre{"target distance from the image centre", "t (s)", "px", {}};
+  closed.centring.label = "closed loop";
+  fixed.centring.label = "head fixed";
+  centre.series = {fixed.centring, closed.centring};
+  fig.panels = {rate, joints, centre};
+  const std::string plot_path = (fs::path(a.out) / "sim_run.png").string();
+  if (auto ok = plot::write_png(fig, plot_path); !ok) return fail(cmd, ok.error());
+
+  std::printf("sim-run %s (%s, seed %llu): %d frames, tracking success %.1f %%\n", scenario->name.c_str(), a.mode.c_str(),
+              static_cast<unsigned long long>(scenario->seed), closed.frames, 100 * success);
+  std::printf("  camera rate RMS (x,y): %.2f deg/s closed loop vs %.2f deg/s head fixed (%.1fx lower)\n",
+              closed.cam_rate_rms_degps, fixed.cam_rate_rms_degps, reduction);
+  std::printf("  target from image centre: %.1f px RMS (max %.1f) vs %.1f px RMS head fixed\n", closed.centring_rms_px,
+              closed.centring_max_px, fixed.centring_rms_px);
+  std::printf("  control loop: %llu ticks, %.4f ms median / %.4f ms p99 per tick; exposure -> command %.2f ms median, %.2f max\n",
+              static_cast<unsigned long long>(run->ticks), run->tick_ms_median, run->tick_ms_p99,
+              run->exposure_to_command_ms_median, run->exposure_to_command_ms_max);
+  std::printf("  tracking %.3f ms median per frame (wall); bus log %s (%llu frames), diagnostics %s\n", run->track_ms_median,
+              (fs::path(a.out) / "bus.log").c_str(), static_cast<unsigned long long>(run->frames_logged),
+              (fs::path(a.out) / "diagnostics.jsonl").c_str());
+  std::printf("  wrote %s, %s and overlays in %s\n", summary_path.c_str(), plot_path.c_str(), a.out.c_str());
+  return 0;
+}
+
+const CommandRegistration registration{
+    "sim-run", "Closed-loop hardware-in-the-loop run of the onboard loop against the simulator", [](CLI::App& app) {
+      auto a = std::make_shared<SimRunArgs>();
+      app.add_option("SCENARIO", a->scenario, "Built-in scenario name or .scn file")->required();
+      app.add_option("--out", a->out, "Output directory")->required();
+      app.add_option("--mode", a->mode, "Head mode: fixate (default), stabilise or hold");
+      app.add_option("--seconds", a->seconds, "Simulated time to run (default: the scenario's frames)")->check(CLI::Range(0.0, 1e6));
+      app.add_option("--every", a->every, "Overlay every N tracked frames (0: none)")->check(CLI::Range(0, 1000000));
+      app.add_option("--downscale", a->downscale, "Render a smaller camera: 1, 2, 4 or 8")->check(CLI::IsMember({1, 2, 4, 8}));
+      app.add_option("--processing-ms", a->processing_ms, "Modelled vision processing time (default 5)")->check(CLI::Range(0.0, 1000.0));
+      app.add_option("--seed", a->seed, "Override the scenario's seed");
+      app.add_option("--jerk", a->jerk, "Override the walking motion's jerk scale")->check(CLI::Range(0.0, 100.0));
+      return [a]() { return run_sim_run(*a); };
+    }};
+
+}  // namespace
+}  // namespace epichead::tools
