@@ -176,7 +176,7 @@ TEST_CASE("score refuses a sequence without gt.csv") {
   const std::string seq = make_sequence(tmp, false);
   const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)));
   CHECK(r.exit_code == 1);
-  CHECK(r.err == "epichead score: " + seq + " has no gt.csv (no ground truth to score against)\n");
+  CHECK(r.err == "epichead score: " + seq + " has no gt.csv (no ground truth to score against); give --reference or --corners\n");
   CHECK(r.out.empty());
 }
 
