@@ -1,7 +1,6 @@
 #pragma once
 // Occluder poses at a time: the scenario's keys when an occluder has any, else the scene's
-// default path. The same rule as simulate_sequence.cpp's (which keeps a private copy that the
-// lead may switch to this helper).
+// default path. Shared by the sequence writer and the closed-loop camera.
 #include <vector>
 
 #include <Eigen/Geometry>

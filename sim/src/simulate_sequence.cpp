@@ -16,6 +16,7 @@
 #include "epichead/sim/scene_library.h"
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
+#include "occluder_motion.h"
 #include "simulate_random.h"
 
 namespace epichead::sim {
@@ -30,40 +31,6 @@ std::string num(double v) {
   return buf;
 }
 std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
-
-// Occluder poses at a time: scenario keys when the occluder has any, else the scene's default path.
-class OccluderMotion {
- public:
-  OccluderMotion(const Scene& scene, const Scenario& s) : scene_(scene), scenario_(s) {}
-  void poses_at(double t_s, std::vector<Eigen::Isometry3d>& out) const {
-    out.clear();
-    for (std::size_t j = 0; j < scene_.occluders.size(); ++j) {
-      const bool has_path = j < scene_.occluder_paths.size();
-      Eigen::Isometry3d pose = has_path ? occluder_pose(scene_.occluder_paths[j], t_s) : Eigen::Isometry3d::Identity();
-      const OccluderKey* prev = nullptr;
-      const OccluderKey* next = nullptr;
-      for (const OccluderKey& k : scenario_.occluder_keys) {
-        if (k.occluder != static_cast<int>(j)) continue;
-        if (k.t_s <= t_s) prev = &k;
-        else if (!next) next = &k;
-      }
-      if (prev || next) {
-        if (has_path) pose.linear() = scene_.occluder_paths[j].world_T_start.linear();
-        if (!prev) pose.translation() = next->position_world;
-        else if (!next) pose.translation() = prev->position_world;
-        else {
-          const double u = (t_s - prev->t_s) / (next->t_s - prev->t_s);
-          pose.translation() = prev->position_world + u * (next->position_world - prev->position_world);
-        }
-      }
-      out.push_back(pose);
-    }
-  }
-
- private:
-  const Scene& scene_;
-  const Scenario& scenario_;
-};
 
 std::expected<void, std::string> prepare_dir(const std::string& out_dir) {
   std::error_code ec;
@@ -184,7 +151,6 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const s
   options.noise_sigma_dn = s.noise_dn;
   Renderer renderer(std::move(*scene), *camera, options);
   const Scene& rscene = renderer.scene();
-  const OccluderMotion rocc(rscene, s);
   std::vector<std::vector<Eigen::Isometry3d>> occ_poses(static_cast<std::size_t>(subframes));
   std::vector<SubFrame> subs(static_cast<std::size_t>(subframes));
   cv::Mat image;
@@ -194,7 +160,7 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const s
     for (int k = 0; k < subframes; ++k) {
       // Sub-frames at the centres of equal slices of the exposure, which is centred on t.
       const double tk = t + exposure_s * ((k + 0.5) / subframes - 0.5);
-      rocc.poses_at(tk, occ_poses[static_cast<std::size_t>(k)]);
+      occluder_poses_at(rscene, s, tk, occ_poses[static_cast<std::size_t>(k)]);
       subs[static_cast<std::size_t>(k)] = {rig.world_T_cam(tk).pose, rscene.world_T_obj, occ_poses[static_cast<std::size_t>(k)]};
     }
     FrameInput input;
