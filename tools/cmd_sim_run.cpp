@@ -140,6 +140,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
     char caption[128];
     std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.report->status),
                   f.report->inliers, f.report->visible);
+    cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3, cv::LINE_AA);  // legible on light scenes
     cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
     char name[64];
     std::snprintf(name, sizeof name, "overlay_%06llu.png", static_cast<unsigned long long>(f.index));
