@@ -2,7 +2,9 @@
 // onboard loop, closed loop against the simulator's camera, IMU, bus and head (hardware in the
 // loop, simulated time), then the same body motion with the head held fixed for comparison.
 // Prints a summary and writes DIR/summary.json, DIR/bus.log (candump; `epichead replay` reads
-// it), DIR/diagnostics.jsonl, DIR/overlay_NNNNNN.png and DIR/*.png plots.
+// it), DIR/diagnostics.jsonl, DIR/timeline.csv (the truth every millisecond: what the head
+// really did, for tuning and for finding where a residual camera rate comes from),
+// DIR/overlay_NNNNNN.png and DIR/*.png plots.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -37,6 +39,7 @@ struct SimRunArgs {
   double processing_ms = 5.0;
   long long seed = -1;
   double jerk = -1;
+  double settle_s = 2.0;
 };
 
 // What one closed run measured against the simulator's truth.
@@ -78,6 +81,13 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   if (!model->vertices.empty()) centre_obj /= static_cast<double>(model->vertices.size());
   double sq_centre = 0;
   long centre_n = 0;
+  std::ofstream timeline;
+  if (render) {
+    timeline.open(fs::path(out) / "timeline.csv");
+    if (!timeline) return std::unexpected("cannot write " + (fs::path(out) / "timeline.csv").string());
+    timeline << "t_s,cam_rate_x_degps,cam_rate_y_degps,cam_rate_z_degps,pan_deg,tilt_deg,pan_rate_degps,tilt_rate_degps,"
+                "target_dx_px,target_dy_px\n";
+  }
   head::OnboardPorts ports;
   ports.clock = &w.clock();
   ports.bus = &w.bus();
@@ -87,15 +97,27 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
     auto truth = w.truth_at(w.now_s());
     if (!truth) return std::unexpected(truth.error());
     const Eigen::Vector3d r = truth->cam_rate_radps * 180.0 / M_PI;
-    sq_xy += r.x() * r.x() + r.y() * r.y();
-    sq_all += r.squaredNorm();
-    ++samples;
+    // The RMS leaves out the first settle_s: the head's first slew toward the target is wanted
+    // motion, not disturbance (the same window is left out of the fixed-head run).
+    if (truth->t_s >= a.settle_s) {
+      sq_xy += r.x() * r.x() + r.y() * r.y();
+      sq_all += r.squaredNorm();
+      ++samples;
+    }
     const Eigen::Vector3d p = truth->cam_T_obj * centre_obj;
     const Eigen::Vector2d off = head::offset_from_centre_px(cam, p);
     if (off.allFinite()) {
       sq_centre += off.squaredNorm();
       ++centre_n;
       m.centring_max_px = std::max(m.centring_max_px, off.norm());
+    }
+    if (timeline.is_open()) {
+      constexpr double deg = 180.0 / M_PI;
+      char row[256];
+      std::snprintf(row, sizeof row, "%.4f,%.4f,%.4f,%.4f,%.5f,%.5f,%.4f,%.4f,%.2f,%.2f\n", truth->t_s, r.x(), r.y(), r.z(),
+                    truth->joints.pan_rad * deg, truth->joints.tilt_rad * deg, truth->joints.pan_rate_radps * deg,
+                    truth->joints.tilt_rate_radps * deg, off.x(), off.y());
+      timeline << row;
     }
     if (samples % 10 == 0) {  // plots at 100 Hz
       m.rate_xy.x.push_back(t_s);
@@ -174,6 +196,8 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
           {"tick_ms_p99", s.tick_ms_p99},
           {"exposure_to_command_ms_median", s.exposure_to_command_ms_median},
           {"exposure_to_command_ms_max", s.exposure_to_command_ms_max},
+          {"frame_age_at_take_ms_median", s.frame_age_at_take_ms_median},
+          {"result_to_command_ms_max", s.result_to_command_ms_max},
           {"controller", {{"rate_limited", s.controller.rate_limited},
                           {"accel_limited", s.controller.accel_limited},
                           {"position_limited", s.controller.position_limited},
@@ -203,15 +227,25 @@ int run_sim_run(const SimRunArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec) return fail(cmd, "cannot create " + a.out + ": " + ec.message());
 
-  RunMeasures closed, fixed;
+  RunMeasures closed, fixed, stabilised;
   auto run = run_once(*scenario, a, mode->second, true, a.out, closed);
   if (!run) return fail(cmd, run.error());
+  // Fixation turns the camera on purpose (toward the target); the stabilisation figure comes
+  // from a run in stabilise mode (blank camera: that mode does not use vision).
+  const bool fixating = mode->second == head::ControlMode::Fixate;
+  if (fixating) {
+    auto st = run_once(*scenario, a, head::ControlMode::Stabilise, false, a.out, stabilised);
+    if (!st) return fail(cmd, "stabilise run: " + st.error());
+  } else {
+    stabilised = closed;
+  }
   // The comparison: the same body motion with the head held still (no rendering needed).
   auto held = run_once(*scenario, a, head::ControlMode::Hold, false, a.out, fixed);
   if (!held) return fail(cmd, "fixed-head run: " + held.error());
 
   const double success = closed.frames ? static_cast<double>(closed.succeeded) / closed.frames : 0.0;
-  const double reduction = closed.cam_rate_rms_degps > 0 ? fixed.cam_rate_rms_degps / closed.cam_rate_rms_degps : 0.0;
+  const double reduction =
+      stabilised.cam_rate_rms_degps > 0 ? fixed.cam_rate_rms_degps / stabilised.cam_rate_rms_degps : 0.0;
   nlohmann::json j{{"scenario", scenario->name},
                    {"mode", a.mode},
                    {"seed", scenario->seed},
@@ -219,7 +253,10 @@ int run_sim_run(const SimRunArgs& a) {
                    {"tracking_success", success},
                    {"frames", closed.frames},
                    {"camera_rate_rms_degps", {{"closed_loop", closed.cam_rate_rms_degps}, {"fixed_head", fixed.cam_rate_rms_degps},
-                                              {"reduction", reduction}, {"axes", "x,y (image-shifting); roll cannot be cancelled"},
+                                              {"stabilise", stabilised.cam_rate_rms_degps},
+                                              {"reduction", reduction}, {"reduction_of", "stabilise vs fixed_head"},
+                                              {"from_t_s", a.settle_s},
+                                              {"axes", "x,y (image-shifting); roll cannot be cancelled"},
                                               {"closed_loop_all_axes", closed.cam_rate_rms_all_degps},
                                               {"fixed_head_all_axes", fixed.cam_rate_rms_all_degps}}},
                    {"centring_px", {{"rms", closed.centring_rms_px}, {"max", closed.centring_max_px},
@@ -234,6 +271,11 @@ int run_sim_run(const SimRunArgs& a) {
   closed.rate_xy.label = "closed loop";
   fixed.rate_xy.label = "head fixed";
   rate.series = {fixed.rate_xy, closed.rate_xy};
+  if (fixating) {
+    closed.rate_xy.label = "closed loop (fixate)";
+    stabilised.rate_xy.label = "closed loop (stabilise)";
+    rate.series = {fixed.rate_xy, closed.rate_xy, stabilised.rate_xy};
+  }
   plot::Panel joints{"head joints", "t (s)", "deg", {closed.pan, closed.tilt}};
   plot::Panel centre{"target distance from the image centre", "t (s)", "px", {}};
   closed.centring.label = "closed loop";
@@ -245,13 +287,18 @@ int run_sim_run(const SimRunArgs& a) {
 
   std::printf("sim-run %s (%s, seed %llu): %d frames, tracking success %.1f %%\n", scenario->name.c_str(), a.mode.c_str(),
               static_cast<unsigned long long>(scenario->seed), closed.frames, 100 * success);
-  std::printf("  camera rate RMS (x,y): %.2f deg/s closed loop vs %.2f deg/s head fixed (%.1fx lower)\n",
-              closed.cam_rate_rms_degps, fixed.cam_rate_rms_degps, reduction);
+  std::printf("  camera rate RMS (x,y, after %.1f s): %.2f deg/s stabilised vs %.2f deg/s head fixed (%.1fx lower)",
+              a.settle_s, stabilised.cam_rate_rms_degps, fixed.cam_rate_rms_degps, reduction);
+  if (fixating) std::printf("; %.2f deg/s while fixating", closed.cam_rate_rms_degps);
+  std::printf("\n");
   std::printf("  target from image centre: %.1f px RMS (max %.1f) vs %.1f px RMS head fixed\n", closed.centring_rms_px,
               closed.centring_max_px, fixed.centring_rms_px);
-  std::printf("  control loop: %llu ticks, %.4f ms median / %.4f ms p99 per tick; exposure -> command %.2f ms median, %.2f max\n",
-              static_cast<unsigned long long>(run->ticks), run->tick_ms_median, run->tick_ms_p99,
-              run->exposure_to_command_ms_median, run->exposure_to_command_ms_max);
+  std::printf("  control loop: %llu ticks, %.4f ms median / %.4f ms p99 per tick (wall)\n",
+              static_cast<unsigned long long>(run->ticks), run->tick_ms_median, run->tick_ms_p99);
+  std::printf("  exposure -> command %.2f ms median (%.2f max) = frame age when taken %.2f ms + processing %.2f ms + "
+              "result -> command <= %.2f ms\n",
+              run->exposure_to_command_ms_median, run->exposure_to_command_ms_max, run->frame_age_at_take_ms_median,
+              a.processing_ms, run->result_to_command_ms_max);
   std::printf("  tracking %.3f ms median per frame (wall); bus log %s (%llu frames), diagnostics %s\n", run->track_ms_median,
               (fs::path(a.out) / "bus.log").c_str(), static_cast<unsigned long long>(run->frames_logged),
               (fs::path(a.out) / "diagnostics.jsonl").c_str());
@@ -271,6 +318,8 @@ const CommandRegistration registration{
       app.add_option("--processing-ms", a->processing_ms, "Modelled vision processing time (default 5)")->check(CLI::Range(0.0, 1000.0));
       app.add_option("--seed", a->seed, "Override the scenario's seed");
       app.add_option("--jerk", a->jerk, "Override the walking motion's jerk scale")->check(CLI::Range(0.0, 100.0));
+      app.add_option("--settle-s", a->settle_s, "Leave the first S seconds (the first slew) out of the rate RMS (default 2)")
+          ->check(CLI::Range(0.0, 1e6));
       return [a]() { return run_sim_run(*a); };
     }};
 

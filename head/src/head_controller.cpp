@@ -83,6 +83,8 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
       {o.target_rate_filter_s, "target_rate_filter_s"}, {o.hold_max_rate_radps, "hold_max_rate_radps"},
       {o.park_rate_radps, "park_rate_radps"}, {o.rate_lead_filter_s, "rate_lead_filter_s"}, {o.park_tolerance_rad, "park_tolerance_rad"},
       {o.max_following_error_rad, "max_following_error_rad"}, {o.history_s, "history_s"},
+      {o.joint_rates.correction_time_constant_s, "joint_rates.correction_time_constant_s"},
+      {o.joint_rates.max_command_age_s, "joint_rates.max_command_age_s"},
       {o.watchdog.imu_timeout_s, "watchdog.imu_timeout_s"}, {o.watchdog.head_state_timeout_s, "watchdog.head_state_timeout_s"},
       {o.watchdog.target_timeout_s, "watchdog.target_timeout_s"}};
   for (const auto& p : pos)
@@ -90,7 +92,8 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
   const struct { double v; const char* name; } nonneg[] = {
       {o.stabilise_gain_per_s, "stabilise_gain_per_s"}, {o.fixate_gain_per_s, "fixate_gain_per_s"},
       {o.target_rate_max_radps, "target_rate_max_radps"}, {o.hold_gain_per_s, "hold_gain_per_s"},
-      {o.switch_blend_s, "switch_blend_s"}, {o.rate_lead_s, "rate_lead_s"}, {o.watchdog.imu_recover_s, "watchdog.imu_recover_s"},
+      {o.switch_blend_s, "switch_blend_s"}, {o.rate_lead_s, "rate_lead_s"}, {o.body_rate_filter_s, "body_rate_filter_s"},
+      {o.joint_rates.command_delay_s, "joint_rates.command_delay_s"}, {o.joint_rates.motor_lag_s, "joint_rates.motor_lag_s"}, {o.watchdog.imu_recover_s, "watchdog.imu_recover_s"},
       {o.watchdog.head_state_recover_s, "watchdog.head_state_recover_s"}, {o.watchdog.bus_recover_s, "watchdog.bus_recover_s"},
       {o.watchdog.lost_to_hold_s, "watchdog.lost_to_hold_s"}};
   for (const auto& p : nonneg)
@@ -111,7 +114,7 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
 
 HeadController::HeadController(const HeadControllerOptions& o)
     // The IMU may run faster than the loop: room for 2 kHz over the history.
-    : options_(o), watchdog_(o.watchdog), attitude_(o.history_s, std::max(o.rate_hz, 2000.0)) {}
+    : options_(o), watchdog_(o.watchdog), attitude_(o.history_s, std::max(o.rate_hz, 2000.0)), joint_rates_(o.joint_rates) {}
 
 void HeadController::emit(ControlOutput& out, const HeadEvent& e) {
   ++counters_.events;
@@ -139,6 +142,7 @@ void HeadController::ingest(const ControlInput& in) {
     } else {
       head_ = h;
       have_head_ = true;
+      joint_rates_.measured(h.t_s, {h.pan_rate_radps, h.tilt_rate_radps});
     }
   }
   if (new_gyro && have_head_) update_body_rate();
@@ -226,9 +230,11 @@ void HeadController::update_body_rate() {
   // Camera rate (camera axes) = body rate + J q_dot: the body rate is what the gyro sees minus
   // what the joints add.
   const Eigen::Matrix<double, 3, 2> J = joint_axes_cam(options_.mount, head_.angles);
-  const Eigen::Vector3d body = gyro_.gyro_radps - J * Eigen::Vector2d(head_.pan_rate_radps, head_.tilt_rate_radps);
+  const Eigen::Vector3d raw = gyro_.gyro_radps - J * joint_rates_.at(gyro_.t_s);
   const double dt = gyro_.t_s - body_rate_t_s_;
+  Eigen::Vector3d body = raw;
   if (have_body_rate_ && dt > 0 && dt <= options_.watchdog.imu_timeout_s) {
+    body = body_rate_cam_ + dt / (options_.body_rate_filter_s + dt) * (raw - body_rate_cam_);
     const double k = std::min(1.0, dt / options_.rate_lead_filter_s);
     body_accel_cam_ += k * ((body - body_rate_cam_) / dt - body_accel_cam_);
   } else {
@@ -347,6 +353,7 @@ ControlOutput HeadController::step(const ControlInput& in) {
   // After a bus-off or a silent head the head has braked on its own (command timeout): restart
   // the command from where it is instead of from where it was told to be.
   if (mode_ != ControlMode::Startup && (has(change.cleared, Fault::BusOff) || has(change.cleared, Fault::HeadStateStale))) {
+    joint_rates_.reset();
     pan_cmd_ = {std::clamp(head_.angles.pan_rad, options_.pan.min_rad, options_.pan.max_rad),
                 clamp_rate(head_.pan_rate_radps, options_.pan)};
     tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
@@ -406,6 +413,7 @@ ControlOutput HeadController::step(const ControlInput& in) {
   c.tilt_rate_radps = wire_rate(tilt_cmd_.rate_radps, counters_.encode_clipped);
   c.counter = counter_;
   if (out.dispatch == Dispatch::Send) {
+    joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps});
     counter_ = static_cast<std::uint8_t>((counter_ + 1) & 0x0f);
     ++counters_.sent;
   } else {

@@ -78,12 +78,13 @@ struct OnboardLoop::Impl {
   // A vision result waiting for its publication time (modelled processing).
   struct Pending {
     bool active = false;
-    double publish_t_s = 0, exposure_t_s = 0;
+    double publish_t_s = 0, exposure_t_s = 0, taken_t_s = 0;
     Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
     Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
     vision::TrackStatus status = vision::TrackStatus::Lost;
   } pending;
   std::optional<double> target_exposure_t_s;  // exposure time of the target given to the controller, until a command uses it
+  double target_publish_t_s = 0;              // when that target was published (the processing done)
 
   std::optional<GyroReading> gyro;
   std::optional<JointState> joints;
@@ -93,7 +94,7 @@ struct OnboardLoop::Impl {
 
   OnboardSummary summary;
   // The last minutes of each timing, for the summary's percentiles.
-  RecentSamples track_ms{1 << 14}, tick_ms{1 << 18}, latency_ms{1 << 14};
+  RecentSamples track_ms{1 << 14}, tick_ms{1 << 18}, latency_ms{1 << 14}, frame_age_ms{1 << 14}, overhead_ms{1 << 14};
   double next_sync_s = 0, next_diag_s = 0;
   std::uint64_t heartbeats = 0;
 
@@ -177,7 +178,8 @@ struct OnboardLoop::Impl {
     track_ms.push(ms);
     ++summary.frames;
     (report.status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
-    pending = {true, options.processing_s >= 0 ? now_s + options.processing_s : ports.clock->now_s(), exposure,
+    frame_age_ms.push(1e3 * (now_s - exposure));
+    pending = {true, options.processing_s >= 0 ? now_s + options.processing_s : ports.clock->now_s(), exposure, now_s,
                report.cam_T_obj, report.covariance, report.status};
     if (hook) hook({summary.frames - 1, exposure, pending.publish_t_s, predicted, &report, &tracker, &frame});
   }
@@ -192,6 +194,7 @@ struct OnboardLoop::Impl {
     predictor.add_vision(pending.exposure_t_s, pending.cam_T_obj, 10.0 * pending.covariance);
     target = target_from_pose(pending.exposure_t_s, pending.cam_T_obj, target_point_obj);
     target_exposure_t_s = pending.exposure_t_s;
+    target_publish_t_s = pending.publish_t_s;
   }
 
   void diagnose(double now_s, const ControlOutput& out) {
@@ -249,6 +252,7 @@ struct OnboardLoop::Impl {
         ++summary.commands_sent;
         if (target_exposure_t_s) {
           latency_ms.push(1e3 * (now_s - *target_exposure_t_s));
+          overhead_ms.push(1e3 * (now_s - target_publish_t_s));
           target_exposure_t_s.reset();
         }
       }
@@ -325,6 +329,8 @@ std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, cons
   out.tick_ms_p99 = s.tick_ms.percentile(0.99);
   out.exposure_to_command_ms_median = s.latency_ms.percentile(0.5);
   out.exposure_to_command_ms_max = s.latency_ms.max();
+  out.frame_age_at_take_ms_median = s.frame_age_ms.percentile(0.5);
+  out.result_to_command_ms_max = s.overhead_ms.max();
   out.controller = s.controller.counters();
   out.imu_assembly = s.assembler.counters();
   out.predictor = s.predictor.status(s.ports.clock->now_s()).counters;

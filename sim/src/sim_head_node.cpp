@@ -125,8 +125,11 @@ void SimHeadNode::plan_joint(int j, double t_s, bool stuck, JointMotion& motor, 
   // reverses, the output rests (the next tick's clamp corrects the few microradians).
   const bool moving_up = motor.rate_radps >= 0 && next_rate >= 0 && (motor.rate_radps > 0 || next_rate > 0);
   const bool moving_down = motor.rate_radps <= 0 && next_rate <= 0 && (motor.rate_radps < 0 || next_rate < 0);
-  const bool pushed_up = out.angle_rad <= motor.angle_rad - half && moving_up;
-  const bool pushed_down = out.angle_rad >= motor.angle_rad + half && moving_down;
+  // "At the edge" with a tolerance: motor and output advance by the same motion but round
+  // differently, and an exact comparison would let the output rest for a tick mid-motion.
+  constexpr double kEdgeToleranceRad = 1e-9;
+  const bool pushed_up = out.angle_rad <= motor.angle_rad - half + kEdgeToleranceRad && moving_up;
+  const bool pushed_down = out.angle_rad >= motor.angle_rad + half - kEdgeToleranceRad && moving_down;
   if (pushed_up || pushed_down) {
     out.angle_rad = motor.angle_rad + (pushed_up ? -half : half);
     out.rate_radps = motor.rate_radps;

@@ -20,6 +20,9 @@ struct Rms {
 Rms run(bool stabilise, const PlantOptions& plant_options, double seconds, std::uint64_t seed, double lead_s = 0) {
   HeadControllerOptions o;
   o.rate_lead_s = lead_s;
+  // The controller is told how its head responds (the head's data sheet or a step test).
+  o.joint_rates.command_delay_s = plant_options.command_latency_s + 0.001;
+  o.joint_rates.motor_lag_s = plant_options.motor_lag_s;
   auto controller = HeadController::create(o);
   REQUIRE(controller);
   HeadPlant plant(o.mount, plant_options, walking_bursts(seconds, seed), {0.0, 0.1});

@@ -219,6 +219,28 @@ TEST_CASE("head node: backlash keeps the output still while the motor crosses th
   CHECK(node.current().pan_out.angle_rad == Approx(0.055).margin(1e-5));
 }
 
+TEST_CASE("head node: once the dead band is taken up the output moves with the motor in every tick of a smooth motion",
+          "[sim][head]") {
+  // Motor and output advance by the same motion but round differently; the output must not
+  // rest for a tick mid-motion (it did: a 30 deg/s joint showed 0 rate for one tick in ten).
+  HeadDynamics d = ideal_dynamics();
+  d.backlash_rad = 0.0005;
+  SimHeadNode node(d, 0.0, 0.0);
+  double t = 0;
+  int still = 0, moving = 0;
+  for (int i = 0; i < 400; ++i) {
+    // A smooth rate profile, never reversing: 0.1 .. 0.6 rad/s.
+    const double rate = 0.35 - 0.25 * std::cos(i * 0.02);
+    node.deliver(command(fw::HeadMode::Rate, 0, 0, rate, 0), t);
+    run(node, t, t + 0.001);
+    if (i < 20) continue;  // the dead band is taken up first
+    ++moving;
+    still += node.current().pan_out.rate_radps == 0;
+  }
+  CHECK(moving == 380);
+  CHECK(still == 0);
+}
+
 TEST_CASE("head node: no command within the timeout stops the head with the timeout fault; a command resumes it",
           "[sim][head]") {
   SimHeadNode node(ideal_dynamics(), 0.0, 0.0);

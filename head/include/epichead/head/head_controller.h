@@ -36,6 +36,7 @@
 #include "epichead/head/control_mode.h"
 #include "epichead/head/gyro_attitude.h"
 #include "epichead/head/head_kinematics.h"
+#include "epichead/head/joint_rate_estimate.h"
 #include "epichead/head/joint_limits.h"
 #include "epichead/head/target_observation.h"
 #include "epichead/head/watchdog.h"
@@ -48,7 +49,7 @@ struct HeadControllerOptions {
   JointLimits pan = default_pan_limits();
   JointLimits tilt = default_tilt_limits();
   double rate_hz = 1000;                  // nominal control rate: a longer tick is integrated as at most 5 nominal ticks
-  double stabilise_gain_per_s = 20;       // optical-axis angle error -> camera rate (1/s)
+  double stabilise_gain_per_s = 60;       // optical-axis angle error -> camera rate (1/s)
   double fixate_gain_per_s = 5;           // target angle error -> camera rate (1/s)
   double fixate_max_rate_radps = 1.5;     // how fast fixation itself may turn the camera
   double target_rate_filter_s = 0.15;     // low-pass time constant of the target direction's rate
@@ -64,6 +65,11 @@ struct HeadControllerOptions {
   // head's measured delay when the motor is slow, see docs/head.md).
   double rate_lead_s = 0;
   double rate_lead_filter_s = 0.004;      // time constant of the derivative's low-pass
+  // The joint rates subtracted from the gyro are those of the gyro sample's instant, from the
+  // commands sent (joint_rate_estimate.h); the difference is low-passed over body_rate_filter_s,
+  // which damps what a timing mismatch between gyro and joints would feed back.
+  JointRateEstimateOptions joint_rates;
+  double body_rate_filter_s = 0.001;
   double switch_blend_s = 0.05;           // rate blend after a mode switch
   double max_following_error_rad = 0.2;   // commanded angle kept this close to the measured one
   double history_s = 0.5;                 // how old a target observation may be
@@ -179,6 +185,7 @@ class HeadController {
   double body_rate_t_s_ = 0;
   Eigen::Vector3d body_rate_cam_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d body_accel_cam_ = Eigen::Vector3d::Zero();
+  JointRateEstimate joint_rates_;
   bool have_target_ = false;
   double target_t_s_ = 0;                 // observation time of the newest valid target
   double target_arrival_t_s_ = 0;         // program time it was given

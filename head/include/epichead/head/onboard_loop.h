@@ -74,7 +74,12 @@ struct OnboardSummary {
   std::uint64_t bus_errors = 0, frames_logged = 0, unknown_frames = 0, undecodable_frames = 0;
   std::uint64_t camera_lost = 0, unreadable_frames = 0;  // device gone; frames of a format the tracker cannot read
   double track_ms_median = 0, track_ms_p99 = 0;                 // wall time of the tracking step
-  double exposure_to_command_ms_median = 0, exposure_to_command_ms_max = 0;  // program clock
+  // Program clock. Exposure -> command = the frame's age when the loop takes it (half the
+  // exposure, the camera's readout and transfer, up to one tick of polling) + processing + the
+  // wait from the result's publication to the command that carries it (result_to_command).
+  double exposure_to_command_ms_median = 0, exposure_to_command_ms_max = 0;
+  double frame_age_at_take_ms_median = 0;
+  double result_to_command_ms_max = 0;
   double tick_ms_median = 0, tick_ms_p99 = 0;                   // wall time of one control tick's work
   HeadCounters controller;
   ImuAssemblyCounters imu_assembly;

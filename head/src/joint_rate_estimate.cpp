@@ -1,0 +1,62 @@
+#include "epichead/head/joint_rate_estimate.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epichead::head {
+
+void JointRateEstimate::sent(double t_s, const Eigen::Vector2d& rates_radps) {
+  const double act_t_s = t_s + options_.command_delay_s;
+  // Where the modelled joint rate stands when this command starts to act.
+  Eigen::Vector2d model = rates_radps;
+  if (count_ > 0) {
+    const Sent& prev = sent_[newest_];
+    if (act_t_s < prev.t_s) return;
+    if (options_.motor_lag_s > 0) model = model_at(prev, act_t_s);
+  } else if (options_.motor_lag_s > 0) {
+    model = measured_;  // the first command starts from the joints' measured motion
+  }
+  newest_ = count_ == 0 ? 0 : (newest_ + 1) % kCapacity;
+  sent_[newest_] = {act_t_s, rates_radps, model};
+  count_ = std::min(count_ + 1, kCapacity);
+}
+
+const JointRateEstimate::Sent* JointRateEstimate::in_force(double t_s) const {
+  for (std::size_t i = 0; i < count_; ++i) {
+    const Sent& s = sent_[(newest_ + kCapacity - i) % kCapacity];
+    if (s.t_s <= t_s) return t_s - s.t_s <= options_.max_command_age_s ? &s : nullptr;
+  }
+  return nullptr;
+}
+
+Eigen::Vector2d JointRateEstimate::model_at(const Sent& s, double t_s) const {
+  if (!(options_.motor_lag_s > 0)) return s.command_radps;
+  const double decay = std::exp(-std::max(0.0, t_s - s.t_s) / options_.motor_lag_s);
+  return s.command_radps + decay * (s.model_radps - s.command_radps);
+}
+
+void JointRateEstimate::measured(double t_s, const Eigen::Vector2d& rates_radps) {
+  if (const Sent* s = in_force(t_s)) {
+    const double dt = have_measured_ ? std::max(0.0, t_s - measured_t_s_) : 0.0;
+    const double k = std::min(1.0, dt / options_.correction_time_constant_s);
+    correction_ += k * (rates_radps - model_at(*s, t_s) - correction_);
+  } else {
+    correction_.setZero();
+  }
+  have_measured_ = true;
+  measured_t_s_ = t_s;
+  measured_ = rates_radps;
+}
+
+Eigen::Vector2d JointRateEstimate::at(double t_s) const {
+  if (const Sent* s = in_force(t_s)) return model_at(*s, t_s) + correction_;
+  return measured_;
+}
+
+void JointRateEstimate::reset() {
+  count_ = 0;
+  newest_ = 0;
+  correction_.setZero();
+}
+
+}  // namespace epichead::head
