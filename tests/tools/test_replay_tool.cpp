@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "common/temp_dir.h"
@@ -274,4 +275,56 @@ TEST_CASE("Replay fails with one line for a missing file, a directory, garbage a
   CHECK(bad.status != 0);
   CHECK(bad.out.find("expected 'epichead' or 'dronecan'") != std::string::npos);
   CHECK(run("replay --help").status == 0);
+}
+
+TEST_CASE("Replay re-runs the fusion predictor and the head watchdog: a cut-out IMU stretch is a dropout, a repeated sample a duplicate") {
+  epichead::testing::TempDir dir("replay_onboard");
+  // A closed-loop log from the simulator (1.5 s, stabilise: no vision needed).
+  const Run sim = run("sim-run mockup_walk --out '" + dir.str() + "/sim' --seconds 1.5 --mode stabilise --downscale 8 --every 0");
+  INFO(sim.out);
+  REQUIRE(sim.status == 0);
+  const std::string original = dir / "sim/bus.log";
+  const json clean = replay_json("'" + original + "'");
+  INFO(clean["fusion"].dump() << clean["head_controller"].dump());
+  CHECK(clean["fusion"]["imu_samples_fed"].get<int>() >= 1400);
+  CHECK(clean["fusion"]["dropouts"].get<int>() == 0);
+  CHECK(clean["fusion"]["growth_after_frame"]["orientation_deg_1sigma"].get<double>() < 0.5);
+  CHECK(clean["head_controller"]["imu_stale_raised"].get<int>() <= 1);  // at most the start-up one
+
+  // Cut the IMU frames (0x110, 0x111) of [1.00, 1.05) s and repeat one gyro/accel pair at 0.5 s.
+  std::ifstream in(original);
+  std::ofstream out(dir / "cut.log");
+  std::string line, last_gyro;
+  double t0 = -1;
+  int cut = 0;
+  bool repeated = false;
+  while (std::getline(in, line)) {
+    const double t = std::stod(line.substr(1));
+    if (t0 < 0) t0 = t;
+    const bool imu = line.find(" 110#") != std::string::npos || line.find(" 111#") != std::string::npos;
+    if (imu && t - t0 >= 1.0 && t - t0 < 1.05) {
+      ++cut;
+      continue;
+    }
+    out << line << '\n';
+    if (line.find(" 110#") != std::string::npos) last_gyro = line;
+    if (!repeated && line.find(" 111#") != std::string::npos && t - t0 >= 0.5) {
+      out << last_gyro << '\n' << line << '\n';
+      repeated = true;
+    }
+  }
+  out.close();
+  REQUIRE(cut >= 90);
+  REQUIRE(repeated);
+  const json j = replay_json("'" + (dir / "cut.log") + "'");
+  INFO(j["fusion"].dump() << j["head_controller"].dump());
+  CHECK(j["fusion"]["dropouts"].get<int>() == 1);
+  CHECK(j["fusion"]["dropout_total_s"].get<double>() == Approx(0.05).margin(0.003));
+  CHECK(j["fusion"]["rejected"]["duplicate"].get<int>() == 1);
+  // The controller's watchdog trips 10 ms into the gap (and once at start-up).
+  CHECK(j["head_controller"]["imu_stale_raised"].get<int>() == clean["head_controller"]["imu_stale_raised"].get<int>() + 1);
+
+  const Run text = run("replay '" + (dir / "cut.log") + "' --plot '" + (dir / "plots") + "'");
+  CHECK(text.out.find("1 dropouts") != std::string::npos);
+  CHECK(std::filesystem::exists(dir / "plots/attitude.png"));
 }

@@ -156,6 +156,7 @@ void LogAnalyzer::add_ours(const fw::CandumpRecord& r, MessageType type, double 
           ms.counter.add(m.counter, gap, nominal);
           if (m.saturated) ++ms.saturated_frames;
           state_series_.add(t_s, {m.pan_rad, m.tilt_rad});
+          if (options_.head_state_observer) options_.head_state_observer(t_s, m);
         } else if constexpr (std::is_same_v<M, fw::HeadStatus>) {
           ms.counter.add(m.counter, gap, nominal);
           if (m.saturated) ++ms.saturated_frames;

@@ -15,6 +15,7 @@
 #include "epichead/firmware_iface/candump_line.h"
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/dronecan_raw_imu.h"
+#include "epichead/firmware_iface/head_state.h"
 #include "epichead/firmware_iface/imu_protocol.h"
 #include "epichead/firmware_iface/stamp_unwrap.h"
 #include "epichead/firmware_iface/wire_error.h"
@@ -37,9 +38,10 @@ struct AnalysisOptions {
   double data_bitrate = 2'000'000;  // CAN FD data phase (BRS)
   // Which IMU stream feeds the observer and the IMU plot; nullopt: both.
   std::optional<firmware_iface::ImuProtocol> imu_protocol;
-  // Called for every complete IMU sample (gyro and accel of one sample). The fusion
-  // predictor's replay hooks in here once the fusion module exists.
+  // Called for every complete IMU sample (gyro and accel of one sample) and every decoded head
+  // state, in log order: the onboard estimators' replay (onboard_replay.h) is fed from here.
   std::function<void(const ImuObservation&)> imu_observer;
+  std::function<void(double t_s, const firmware_iface::HeadState&)> head_state_observer;
 };
 
 struct IdStats {

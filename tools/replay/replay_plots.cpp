@@ -4,6 +4,7 @@
 
 #include "epichead/firmware_iface/can_ids.h"
 #include "plot/line_plot.h"
+#include "replay/onboard_replay.h"
 
 namespace epichead::tools::replay {
 
@@ -96,6 +97,22 @@ std::expected<std::vector<std::string>, std::string> write_plots(const LogAnalyz
   if (!a.head_command_series().empty() || !a.head_state_series().empty())
     if (auto r = write(head_figure(a, title), "head.png"); !r) return std::unexpected(r.error());
   return written;
+}
+
+std::expected<void, std::string> write_attitude_plot(const OnboardReplay& r, const std::string& dir,
+                                                     const std::string& title) {
+  const auto& s = r.attitude_series();
+  if (s.empty()) return {};
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return std::unexpected(dir + ": cannot create directory (" + ec.message() + ")");
+  const auto t = relative(s.t(), r.first_t_s());
+  plot::Panel p{"camera attitude from the IMU (fusion predictor, re-started every second)", "time since start [s]",
+                "deg", {}};
+  p.series = {{"roll (about the optical axis)", t, s.column(0)},
+              {"pitch (optical axis up)", t, s.column(1)},
+              {"yaw (optical axis right)", t, s.column(2)}};
+  return plot::write_png({title + ": attitude", {p}}, (std::filesystem::path(dir) / "attitude.png").string());
 }
 
 }  // namespace epichead::tools::replay
