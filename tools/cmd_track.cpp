@@ -34,7 +34,7 @@ struct TrackArgs {
   int max_frames = 0;
   bool video = true;
   double crease_deg = 20.0;
-  double imu_time_offset_s = 0;
+  std::string imu_time_offset = "auto";
 };
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
@@ -99,7 +99,15 @@ int run_track(const TrackArgs& args) {
   if (args.imu != "on" && args.imu != "off") return fail(cmd, "--imu must be on or off, got '" + args.imu + "'");
   auto seq = Sequence::open(args.seq);
   if (!seq) return fail(cmd, seq.error());
-  auto predictor = make_track_predictor(*seq, args.imu == "on", args.imu_time_offset_s);
+  std::optional<double> offset;
+  if (args.imu_time_offset != "auto") {
+    char* end = nullptr;
+    const double v = std::strtod(args.imu_time_offset.c_str(), &end);
+    if (end == args.imu_time_offset.c_str() || *end != '\0' || !std::isfinite(v) || std::abs(v) > 10)
+      return fail(cmd, "--imu-time-offset-s must be 'auto' or seconds within +-10, got '" + args.imu_time_offset + "'");
+    offset = v;
+  }
+  auto predictor = make_track_predictor(*seq, args.imu == "on", offset);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -234,8 +242,9 @@ const CommandRegistration registration{
       app.add_option("--every", a->every, "Write a PNG overlay every N frames and at the last (0: none; default 30)")
           ->check(CLI::Range(0, 1000000));
       app.add_option("--frames", a->max_frames, "Track only the first N frames (0: all)")->check(CLI::Range(0, 100000000));
-      app.add_option("--imu-time-offset-s", a->imu_time_offset_s,
-                     "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset; default 0)");
+      app.add_option("--imu-time-offset-s", a->imu_time_offset,
+                     "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset), s, or 'auto' "
+                     "(default: estimated from the gyro and the tracked poses once the camera has turned enough)");
       app.add_flag("!--no-video", a->video, "Do not write overlay.mp4");
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
       return [a]() { return run_track(*a); };

@@ -69,10 +69,8 @@ track_all() {
       local dir="$out/$label/$mode-imu-$imu"
       mkdir -p "$out/$label"
       echo "results: $label $mode imu $imu"
-      # A simulated recording states its IMU clock offset (a real one maps stamps by time sync).
-      local offset=0
-      [[ -f "$seq/sim_truth.json" ]] && offset=$(jq -r '.imu.clock_offset_s' "$seq/sim_truth.json")
-      if ! "$bin" track "$seq" --out "$dir" --mode "$mode" --imu "$imu" --imu-time-offset-s "$offset" --every 50 \
+      # The IMU clock offset is estimated by the tracker (--imu-time-offset-s auto, the default).
+      if ! "$bin" track "$seq" --out "$dir" --mode "$mode" --imu "$imu" --every 50 \
           > "$dir.log" 2>&1; then
         echo "results: track failed on $label ($mode, imu $imu): $(tail -1 "$dir.log")" >&2
         continue

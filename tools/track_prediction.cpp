@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "epichead/fusion/predictor.h"
+#include "epichead/fusion/time_offset_estimator.h"
 
 namespace epichead::tools {
 namespace {
@@ -50,8 +51,11 @@ class ConstantVelocityPredictor final : public TrackPredictor {
 // after lost_reset_s without a pose the filter restarts from the next one.
 class ImuPredictor final : public TrackPredictor {
  public:
-  ImuPredictor(fusion::Predictor predictor, const vision::Sequence& seq, double time_offset_s)
-      : predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(time_offset_s), last_good_(seq.init().cam_T_obj) {
+  // With an estimator the offset is found from the data (auto) and the filter restarts with it.
+  ImuPredictor(const fusion::PredictorOptions& options, fusion::Predictor predictor, const vision::Sequence& seq,
+               std::optional<fusion::TimeOffsetEstimator> estimator)
+      : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
+        estimator_(std::move(estimator)), last_good_(seq.init().cam_T_obj) {
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
     init_t_s_ = seq.init().t_s;
@@ -81,6 +85,14 @@ class ImuPredictor final : public TrackPredictor {
     reset_done_ = false;
     last_good_ = report.cam_T_obj;
     last_good_t_s_ = t_s;
+    if (estimator_ && !adopted_) {
+      estimator_->add_pose(t_s, report.cam_T_obj);
+      // A fit costs about a millisecond: try a few times a second, not every frame.
+      if (++frames_since_fit_ >= kFitEveryFrames) {
+        frames_since_fit_ = 0;
+        if (const auto e = estimator_->estimate()) return adopt(*e, t_s, report);
+      }
+    }
     // The estimator's covariance assumes independent edgels; neighbouring edgels of one blurred
     // edge are not, so it is optimistic by about the number of edgels per line: inflate it.
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, kCovarianceInflation * report.covariance);
@@ -89,8 +101,16 @@ class ImuPredictor final : public TrackPredictor {
   nlohmann::json diagnostics() const override {
     const auto st = predictor_.status(last_good_t_s_);
     const auto& c = st.counters;
+    nlohmann::json estimated = nullptr;
+    if (estimator_) {
+      estimated = {{"adopted", adopted_}, {"adopted_at_s", adopted_ ? adopted_at_s_ : -1.0}};
+      if (const auto e = adopted_ ? std::optional(adopted_fit_) : estimator_->fit())
+        estimated.update({{"offset_s", e->offset_s}, {"explained", e->explained}, {"pairs", e->pairs},
+                          {"rate_rms_radps", e->rate_rms_radps}});
+    }
     return {{"model", "imu"},
             {"imu_time_offset_s", offset_s_},
+            {"imu_time_offset_estimate", estimated},
             {"imu_accepted", c.imu_accepted},
             {"imu_rejected", c.imu_non_finite + c.imu_saturated + c.imu_out_of_order + c.imu_duplicate},
             {"imu_saturated", c.imu_saturated},
@@ -108,6 +128,7 @@ class ImuPredictor final : public TrackPredictor {
  private:
   static constexpr double kLostResetS = 1.0;
   static constexpr double kCovarianceInflation = 10.0;
+  static constexpr int kFitEveryFrames = 10;
   void feed_until(double t_s) {
     const auto& imu = *imu_;
     while (next_ < imu.size() && imu[next_].t_s - offset_s_ <= t_s) {
@@ -116,9 +137,37 @@ class ImuPredictor final : public TrackPredictor {
       s.gyro_radps = imu[next_].gyro_radps;
       s.accel_mps2 = imu[next_].accel_mps2;
       predictor_.add_imu(s);
+      // The estimator sees the gyro ahead of the camera by the search range, so every
+      // candidate offset has samples.
       ++next_;
     }
+    if (estimator_ && !adopted_)
+      while (estimator_next_ < imu.size() && imu[estimator_next_].t_s <= t_s + kEstimatorLeadS) {
+        estimator_->add_gyro(imu[estimator_next_].t_s, imu[estimator_next_].gyro_radps);
+        ++estimator_next_;
+      }
   }
+  // Restart the filter on the estimated offset from this frame's pose: samples from just
+  // before it are fed again on the new clock mapping.
+  void adopt(const fusion::TimeOffsetEstimate& e, double t_s, const vision::FrameReport& report) {
+    adopted_ = true;
+    adopted_fit_ = e;
+    adopted_at_s_ = t_s;
+    offset_s_ = e.offset_s;
+    fusion::PredictorOptions o = options_;
+    o.imu_time_offset_s = offset_s_;
+    auto p = fusion::Predictor::create(o);
+    if (!p) return;  // options were valid once; only the offset changed
+    predictor_ = std::move(*p);
+    const auto& imu = *imu_;
+    next_ = 0;
+    while (next_ < imu.size() && imu[next_].t_s - offset_s_ < t_s - options_.gravity_average_s - 0.05) ++next_;
+    feed_until(t_s);
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, kCovarianceInflation * report.covariance);
+    pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
+    init_t_s_ = t_s;
+  }
+  fusion::PredictorOptions options_;
   fusion::Predictor predictor_;
   const std::vector<vision::ImuRecord>* imu_;
   std::size_t next_ = 0;
@@ -127,21 +176,35 @@ class ImuPredictor final : public TrackPredictor {
   double last_good_t_s_ = 0, init_t_s_ = 0;
   bool pending_init_ = false, reset_done_ = false;
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
+  // Offset estimation (auto).
+  static constexpr double kEstimatorLeadS = 0.15;
+  std::optional<fusion::TimeOffsetEstimator> estimator_;
+  std::size_t estimator_next_ = 0;
+  bool adopted_ = false;
+  fusion::TimeOffsetEstimate adopted_fit_;
+  double adopted_at_s_ = 0;
+  int frames_since_fit_ = 0;
 };
 
 }  // namespace
 
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 double imu_time_offset_s) {
+                                                                                 std::optional<double> imu_time_offset_s) {
   if (use_imu) {
     if (!seq.has_imu()) return std::unexpected("--imu on: " + seq.dir() + " has no imu.csv");
-    if (!std::isfinite(imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
+    if (imu_time_offset_s && !std::isfinite(*imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
-    options.imu_time_offset_s = imu_time_offset_s;
+    options.imu_time_offset_s = imu_time_offset_s.value_or(0.0);
     auto predictor = fusion::Predictor::create(options);
     if (!predictor) return std::unexpected("--imu on: " + predictor.error());
-    return std::make_unique<ImuPredictor>(std::move(*predictor), seq, imu_time_offset_s);
+    std::optional<fusion::TimeOffsetEstimator> estimator;
+    if (!imu_time_offset_s) {
+      auto e = fusion::TimeOffsetEstimator::create();
+      if (!e) return std::unexpected("--imu on: " + e.error());
+      estimator.emplace(std::move(*e));
+    }
+    return std::make_unique<ImuPredictor>(options, std::move(*predictor), seq, std::move(estimator));
   }
   return std::make_unique<ConstantVelocityPredictor>(seq.init().t_s, seq.init().cam_T_obj);
 }

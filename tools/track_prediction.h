@@ -4,6 +4,7 @@
 // After a loss the prediction restarts from the last good pose.
 #include <expected>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -26,8 +27,10 @@ class TrackPredictor {
 };
 
 // --imu on needs the sequence's imu.csv; the error says so when it is missing. The IMU's clock
-// runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset).
+// runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset). Without a value
+// (auto) the offset starts at 0 and is estimated from the tracked poses and the gyro
+// (fusion/time_offset_estimator.h); once the estimate is confident the filter restarts with it.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 double imu_time_offset_s = 0);
+                                                                                 std::optional<double> imu_time_offset_s);
 
 }  // namespace epichead::tools

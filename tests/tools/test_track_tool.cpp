@@ -49,6 +49,30 @@ TEST_CASE("track follows a short simulated mockup_walk with epic+validation and 
   CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
 }
 
+TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the tracked poses (auto) and tracks every frame") {
+  TempDir tmp("epichead_test_track_offset");
+  const std::string seq = tmp / "mockup_walk", out = tmp / "track";
+  // 3 s: two step bursts, enough turning for the fit (1.5 s of poses at least).
+  REQUIRE(run_epichead(tmp, "sim mockup_walk --out " + q(seq) + " --frames 90").exit_code == 0);
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --imu on --every 0 --no-video");
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto truth = nlohmann::json::parse(slurp(seq + "/sim_truth.json"));
+  const auto& est = report["predictor"]["imu_time_offset_estimate"];
+  INFO(est.dump());
+  REQUIRE(est["adopted"].get<bool>());
+  CHECK(report["predictor"]["imu_time_offset_s"].get<double>() ==
+        Approx(truth["imu"]["clock_offset_s"].get<double>()).margin(0.003));
+  CHECK(report["lost"].get<int>() == 0);
+  // A given offset is used as it is.
+  const auto fixed = run_epichead(tmp, "track " + q(seq) + " --out " + q(tmp / "fixed") + " --imu on --imu-time-offset-s 0.01 --every 0 --no-video");
+  REQUIRE(fixed.exit_code == 0);
+  const auto fr = nlohmann::json::parse(slurp(tmp / "fixed/report.json"));
+  CHECK(fr["predictor"]["imu_time_offset_s"].get<double>() == 0.01);
+  CHECK(fr["predictor"]["imu_time_offset_estimate"].is_null());
+}
+
 TEST_CASE("track follows the real teabox video to within a few pixels of the hand-read corners") {
   TempDir tmp("epichead_test_track_tool");
   const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox", out = tmp / "teabox";
@@ -83,6 +107,9 @@ TEST_CASE("track rejects bad arguments with one line and a non-zero exit") {
   r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --imu on");
   CHECK(r.exit_code != 0);
   CHECK(r.err.find("imu.csv") != std::string::npos);
+  r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --imu-time-offset-s soon");
+  CHECK(r.exit_code != 0);
+  CHECK(r.err.find("'auto' or seconds") != std::string::npos);
   r = run_epichead(tmp, "track --help");
   CHECK(r.exit_code == 0);
   CHECK(r.out.find("--mode") != std::string::npos);

@@ -1,0 +1,82 @@
+#pragma once
+// The time offset between the IMU's clock and the camera's, from the data itself: the camera's
+// angular rate between two tracked poses must equal the gyro's mean rate over the same
+// interval, once the interval is moved onto the IMU clock (t_imu = t_camera + offset). The
+// estimate is the offset in [-max, +max] that minimises the summed squared difference over the
+// recent pose pairs (a grid search refined by a parabola through the best three points), with
+// how much of the camera's rate variation it explains as the confidence. Vectors, not rate
+// magnitudes, are compared, so a rotation about one axis cannot be matched by another.
+//
+// Why not a filter state: the offset is constant per rig and session, shows only while the
+// camera turns, and a wrong early value would corrupt the pose filter; a batch fit over a few
+// seconds of motion is robust and cheap, and the caller decides when to adopt it.
+// Fixed storage from create(); add_gyro and add_pose do not allocate.
+#include <cstddef>
+#include <expected>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace epichead::fusion {
+
+struct TimeOffsetOptions {
+  double max_offset_s = 0.1;        // search range: +-this
+  double step_s = 0.0005;           // grid step before the parabolic refinement
+  double window_s = 4.0;            // pose pairs from this far back are used
+  double imu_rate_hz = 1000;        // sizes the gyro store
+  double max_pair_gap_s = 0.1;      // poses further apart than this are not paired
+  int min_pairs = 45;             // 1.5 s of poses at 30 Hz
+  double min_rate_rms_radps = 0.15;  // the camera must turn at least this much (RMS) to tell
+  double min_explained = 0.6;       // fraction of the rate variation the fit must explain
+  Eigen::Matrix3d cam_R_imu = Eigen::Matrix3d::Identity();
+};
+
+struct TimeOffsetEstimate {
+  double offset_s = 0;              // t_imu = t_camera + offset_s
+  double explained = 0;             // 1 - residual / variation of the camera's rate
+  int pairs = 0;
+  double rate_rms_radps = 0;        // the camera's rate RMS over the pairs (excitation)
+  bool at_search_edge = false;      // the best grid point was at +-max_offset_s
+};
+
+class TimeOffsetEstimator {
+ public:
+  static std::expected<TimeOffsetEstimator, std::string> create(const TimeOffsetOptions& options = {});
+
+  // A gyro sample on the IMU clock, IMU axes. Out-of-order or non-finite samples are ignored.
+  void add_gyro(double t_imu_s, const Eigen::Vector3d& gyro_radps);
+  // A good tracked pose on the camera clock. Non-finite or out-of-order poses are ignored.
+  void add_pose(double t_cam_s, const Eigen::Isometry3d& cam_T_obj);
+
+  // The fit over the recent pairs whatever its quality (empty without enough pairs or gyro).
+  std::optional<TimeOffsetEstimate> fit() const;
+  // The fit when it passes the options' quality bars (pairs, excitation, explained, not at the
+  // edge of the search range).
+  std::optional<TimeOffsetEstimate> estimate() const;
+
+ private:
+  explicit TimeOffsetEstimator(const TimeOffsetOptions& options);
+  // Mean gyro (camera axes) over [a, b] on the IMU clock; false when outside the stored span.
+  bool mean_rate(double a, double b, Eigen::Vector3d& out) const;
+  struct Pair {
+    double t0_s, t1_s;        // camera clock
+    Eigen::Vector3d rate;     // camera axes, rad/s
+  };
+  bool usable(const Pair& p) const;
+  double cost(double offset_s) const;
+  TimeOffsetOptions options_;
+  // Gyro samples and the running integral of the rate (camera axes) at each, oldest first.
+  std::vector<double> t_;
+  std::vector<Eigen::Vector3d> integral_;
+  std::vector<Pair> pairs_;  // oldest first
+  mutable std::vector<double> costs_;  // fit()'s grid, sized at create()
+  bool have_pose_ = false;
+  double last_pose_t_s_ = 0;
+  Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d last_gyro_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace epichead::fusion

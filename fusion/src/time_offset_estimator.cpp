@@ -1,0 +1,145 @@
+#include "epichead/fusion/time_offset_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "epichead/fusion/lie.h"
+
+namespace epichead::fusion {
+
+namespace {
+
+// Drops the oldest entries of a full store in one move (no allocation: the capacity stays).
+template <typename T>
+void drop_front(std::vector<T>& v, std::size_t n) {
+  v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(n, v.size())));
+}
+
+}  // namespace
+
+std::expected<TimeOffsetEstimator, std::string> TimeOffsetEstimator::create(const TimeOffsetOptions& o) {
+  const double values[] = {o.max_offset_s, o.step_s, o.window_s, o.imu_rate_hz, o.max_pair_gap_s, o.min_rate_rms_radps};
+  for (double v : values)
+    if (!std::isfinite(v) || !(v > 0)) return std::unexpected("time offset estimator: ranges, step, window and rates must be positive");
+  if (o.step_s > o.max_offset_s) return std::unexpected("time offset estimator: step_s larger than max_offset_s");
+  if (o.min_pairs < 3) return std::unexpected("time offset estimator: min_pairs must be at least 3");
+  if (!o.cam_R_imu.allFinite()) return std::unexpected("time offset estimator: cam_R_imu not finite");
+  return TimeOffsetEstimator(o);
+}
+
+TimeOffsetEstimator::TimeOffsetEstimator(const TimeOffsetOptions& o) : options_(o) {
+  const auto gyro_capacity = static_cast<std::size_t>((o.window_s + 2 * o.max_offset_s + 1.0) * o.imu_rate_hz * 2);
+  t_.reserve(gyro_capacity);
+  integral_.reserve(gyro_capacity);
+  pairs_.reserve(static_cast<std::size_t>(o.window_s * 400) + 16);  // up to 400 poses/s
+  costs_.reserve(static_cast<std::size_t>(2 * std::floor(o.max_offset_s / o.step_s) + 1));
+}
+
+void TimeOffsetEstimator::add_gyro(double t_imu_s, const Eigen::Vector3d& gyro_radps) {
+  if (!std::isfinite(t_imu_s) || !gyro_radps.allFinite() || (!t_.empty() && !(t_imu_s > t_.back()))) return;
+  const Eigen::Vector3d g = options_.cam_R_imu * gyro_radps;
+  if (t_.size() == t_.capacity()) {
+    const std::size_t n = t_.size() / 2;
+    drop_front(t_, n);
+    drop_front(integral_, n);
+  }
+  // The rate is integrated with the trapezoid rule: the integral's differences give the mean
+  // rate over any interval between samples.
+  const Eigen::Vector3d next = t_.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(integral_.back() + 0.5 * (last_gyro_ + g) * (t_imu_s - t_.back()));
+  t_.push_back(t_imu_s);
+  integral_.push_back(next);
+  last_gyro_ = g;
+}
+
+void TimeOffsetEstimator::add_pose(double t_cam_s, const Eigen::Isometry3d& cam_T_obj) {
+  if (!std::isfinite(t_cam_s) || !cam_T_obj.matrix().allFinite()) return;
+  if (have_pose_ && !(t_cam_s > last_pose_t_s_)) return;
+  const Eigen::Matrix3d R = cam_T_obj.linear();
+  if (have_pose_ && t_cam_s - last_pose_t_s_ <= options_.max_pair_gap_s) {
+    // cam_a_R_cam_b = R_a R_b^T = exp(w dt), w in camera axes.
+    const Eigen::Vector3d w = so3_log(last_R_ * R.transpose()) / (t_cam_s - last_pose_t_s_);
+    if (pairs_.size() == pairs_.capacity()) drop_front(pairs_, pairs_.size() / 2);
+    pairs_.push_back({last_pose_t_s_, t_cam_s, w});
+  }
+  // Pairs older than the window are not used.
+  std::size_t old = 0;
+  while (old < pairs_.size() && pairs_[old].t1_s < t_cam_s - options_.window_s) ++old;
+  if (old > 0) drop_front(pairs_, old);
+  have_pose_ = true;
+  last_pose_t_s_ = t_cam_s;
+  last_R_ = R;
+}
+
+bool TimeOffsetEstimator::mean_rate(double a, double b, Eigen::Vector3d& out) const {
+  if (t_.size() < 2 || a < t_.front() || b > t_.back() || !(b > a)) return false;
+  auto at = [&](double t) {
+    const auto it = std::upper_bound(t_.begin(), t_.end(), t);
+    const std::size_t i = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(it - t_.begin(), 1, static_cast<std::ptrdiff_t>(t_.size() - 1)));
+    const double f = (t - t_[i - 1]) / (t_[i] - t_[i - 1]);
+    return Eigen::Vector3d(integral_[i - 1] + f * (integral_[i] - integral_[i - 1]));
+  };
+  out = (at(b) - at(a)) / (b - a);
+  return true;
+}
+
+bool TimeOffsetEstimator::usable(const Pair& p) const {
+  // Every candidate offset must find the pair's shifted interval inside the stored gyro span,
+  // so that all candidates are scored on the same pairs.
+  return t_.size() >= 2 && p.t0_s - options_.max_offset_s >= t_.front() && p.t1_s + options_.max_offset_s <= t_.back();
+}
+
+double TimeOffsetEstimator::cost(double offset_s) const {
+  double sum = 0;
+  Eigen::Vector3d g;
+  for (const Pair& p : pairs_)
+    if (usable(p) && mean_rate(p.t0_s + offset_s, p.t1_s + offset_s, g)) sum += (p.rate - g).squaredNorm();
+  return sum;
+}
+
+std::optional<TimeOffsetEstimate> TimeOffsetEstimator::fit() const {
+  int n = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double sq = 0;
+  for (const Pair& p : pairs_) {
+    if (!usable(p)) continue;
+    mean += p.rate;
+    sq += p.rate.squaredNorm();
+    ++n;
+  }
+  if (n < 3) return std::nullopt;
+  mean /= n;
+  double var = 0;
+  for (const Pair& p : pairs_)
+    if (usable(p)) var += (p.rate - mean).squaredNorm();
+
+  const int steps = static_cast<int>(std::floor(options_.max_offset_s / options_.step_s));
+  costs_.resize(static_cast<std::size_t>(2 * steps + 1));  // within the capacity reserved at create()
+  int best_k = -steps;
+  for (int k = -steps; k <= steps; ++k) {
+    costs_[static_cast<std::size_t>(k + steps)] = cost(k * options_.step_s);
+    if (costs_[static_cast<std::size_t>(k + steps)] < costs_[static_cast<std::size_t>(best_k + steps)]) best_k = k;
+  }
+  TimeOffsetEstimate e;
+  e.pairs = n;
+  e.rate_rms_radps = std::sqrt(sq / n);
+  e.at_search_edge = best_k == -steps || best_k == steps;
+  const double best = costs_[static_cast<std::size_t>(best_k + steps)];
+  e.offset_s = best_k * options_.step_s;
+  if (!e.at_search_edge) {
+    const double cm = costs_[static_cast<std::size_t>(best_k + steps - 1)], cp = costs_[static_cast<std::size_t>(best_k + steps + 1)];
+    const double curvature = cm - 2 * best + cp;
+    if (curvature > 0) e.offset_s += 0.5 * (cm - cp) / curvature * options_.step_s;
+  }
+  e.explained = var > 0 ? 1.0 - best / var : 0.0;
+  return e;
+}
+
+std::optional<TimeOffsetEstimate> TimeOffsetEstimator::estimate() const {
+  auto e = fit();
+  if (!e || e->pairs < options_.min_pairs || e->rate_rms_radps < options_.min_rate_rms_radps ||
+      e->explained < options_.min_explained || e->at_search_edge)
+    return std::nullopt;
+  return e;
+}
+
+}  // namespace epichead::fusion

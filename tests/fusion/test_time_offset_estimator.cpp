@@ -1,0 +1,124 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "epichead/fusion/lie.h"
+#include "epichead/fusion/time_offset_estimator.h"
+
+using namespace epichead::fusion;
+
+namespace {
+
+// A camera turning in bursts about changing axes (camera axes, rad/s).
+Eigen::Vector3d rate_at(double t) {
+  const double burst = std::exp(-std::pow(std::fmod(t, 0.7) - 0.35, 2) / (2 * 0.05 * 0.05));
+  return Eigen::Vector3d(1.2 * std::sin(2.1 * t), 0.8 * std::cos(1.3 * t), 0.3) * burst + Eigen::Vector3d(0.1, -0.05, 0.02);
+}
+
+struct Feed {
+  double offset_s = 0.0213;  // t_imu = t_camera + offset
+  double pose_noise_rad = 0.0009;  // about 0.05 deg per pose
+  double gyro_noise_radps = 0.008;
+  double seconds = 4.0;
+  Eigen::Matrix3d cam_R_imu = Eigen::Matrix3d::Identity();
+};
+
+// Feeds the estimator as the tracker would: gyro at 1 kHz on the IMU clock, poses at 30 Hz on the camera clock.
+void feed(TimeOffsetEstimator& e, const Feed& f, std::uint32_t seed = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0, 1);
+  Eigen::Matrix3d obj_R_cam = Eigen::Matrix3d::Identity();
+  double next_pose = 0.0;
+  const double dt = 1e-4;  // truth integration step
+  for (int i = 0; i <= static_cast<int>(f.seconds / dt); ++i) {
+    const double t = i * dt;  // camera clock
+    const Eigen::Vector3d w = rate_at(t);
+    if (i % 10 == 0) {
+      const Eigen::Vector3d g = w + f.gyro_noise_radps * Eigen::Vector3d(n(rng), n(rng), n(rng));
+      e.add_gyro(t + f.offset_s, f.cam_R_imu.transpose() * g);
+    }
+    if (t >= next_pose - 1e-12) {
+      next_pose += 1.0 / 30;
+      const Eigen::Matrix3d noisy = obj_R_cam * so3_exp(f.pose_noise_rad * Eigen::Vector3d(n(rng), n(rng), n(rng)));
+      Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
+      cam_T_obj.linear() = noisy.transpose();
+      e.add_pose(t, cam_T_obj);
+    }
+    obj_R_cam = obj_R_cam * so3_exp(w * dt);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("time offset: recovered within a millisecond from turning bursts, gyro noise and pose noise",
+          "[fusion][time_offset]") {
+  for (double offset : {0.0213, -0.035, 0.0}) {
+    auto e = TimeOffsetEstimator::create();
+    REQUIRE(e);
+    Feed f;
+    f.offset_s = offset;
+    feed(*e, f);
+    const auto est = e->estimate();
+    REQUIRE(est);
+    INFO("true " << offset << " estimated " << est->offset_s << " explained " << est->explained << " pairs " << est->pairs);
+    CHECK(est->offset_s == Approx(offset).margin(0.001));
+    CHECK(est->explained > 0.9);
+  }
+}
+
+TEST_CASE("time offset: the IMU's mounting rotation is applied before comparing", "[fusion][time_offset]") {
+  TimeOffsetOptions o;
+  o.cam_R_imu = so3_exp(Eigen::Vector3d(0, 0, M_PI / 2));
+  auto e = TimeOffsetEstimator::create(o);
+  REQUIRE(e);
+  Feed f;
+  f.cam_R_imu = o.cam_R_imu;
+  feed(*e, f);
+  const auto est = e->estimate();
+  REQUIRE(est);
+  CHECK(est->offset_s == Approx(f.offset_s).margin(0.001));
+}
+
+TEST_CASE("time offset: no estimate while the camera is still, or from too few poses", "[fusion][time_offset]") {
+  auto e = TimeOffsetEstimator::create();
+  REQUIRE(e);
+  // Still: only noise.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 4000; ++i) e->add_gyro(i * 1e-3, Eigen::Vector3d::Zero());
+  for (int k = 0; k < 100; ++k) e->add_pose(0.2 + k / 30.0, pose);
+  CHECK_FALSE(e->estimate());
+  // Moving but for half a second only (15 poses).
+  auto short_run = TimeOffsetEstimator::create();
+  REQUIRE(short_run);
+  Feed f;
+  f.seconds = 0.5;
+  feed(*short_run, f);
+  CHECK_FALSE(short_run->estimate());
+}
+
+TEST_CASE("time offset: an offset beyond the search range is not reported as one at its edge", "[fusion][time_offset]") {
+  auto e = TimeOffsetEstimator::create();
+  REQUIRE(e);
+  Feed f;
+  f.offset_s = 0.3;  // three times the range
+  feed(*e, f);
+  CHECK_FALSE(e->estimate());
+}
+
+TEST_CASE("time offset: bad options and bad samples are refused", "[fusion][time_offset]") {
+  TimeOffsetOptions o;
+  o.step_s = 0;
+  CHECK_FALSE(TimeOffsetEstimator::create(o));
+  o = {};
+  o.min_pairs = 1;
+  CHECK_FALSE(TimeOffsetEstimator::create(o));
+  auto e = TimeOffsetEstimator::create();
+  REQUIRE(e);
+  e->add_gyro(NAN, Eigen::Vector3d::Zero());
+  e->add_gyro(1.0, Eigen::Vector3d(NAN, 0, 0));
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = NAN;
+  e->add_pose(1.0, bad);
+  CHECK_FALSE(e->fit());
+}
