@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "command.h"
+#include "line_selection_score.h"
 #include "epichead/vision/score.h"
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
@@ -99,6 +100,7 @@ const CommandRegistration registration{
       auto per_frame = std::make_shared<std::string>();
       auto reference = std::make_shared<std::string>();
       auto corners = std::make_shared<std::vector<std::string>>();
+      auto lines = std::make_shared<std::string>();
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
@@ -111,6 +113,8 @@ const CommandRegistration registration{
                      "Write frame,present,success,rotation_deg,translation_mm,reprojection_px to this CSV");
       app.add_option("--reference", *reference,
                      "Compare with these poses instead of gt.csv (e.g. another tracker's reference_visp.csv)");
+      app.add_option("--lines", *lines,
+                     "The tracker's lines.csv: also score which image line it selected for each edge against the truth");
       app.add_option("--corners", *corners,
                      "FRAME:FILE: hand-read corners (X Y Z u v per line) of one frame; reports the distance of the "
                      "projected model points (repeatable)");
@@ -177,6 +181,12 @@ const CommandRegistration registration{
 
         const ScoreSummary summary =
             vision::score_poses(truth_poses, *estimates, seq->camera(), seq->model(), axis);
+        nlohmann::json line_json = nullptr;
+        if (!lines->empty()) {
+          auto ls = score_line_selection(*lines, *seq, truth_poses);
+          if (!ls) return fail("score", ls.error());
+          line_json = to_json(*ls);
+        }
         std::set<int> truth_frames;
         for (const auto& g : truth_poses) truth_frames.insert(g.frame);
         int ignored = 0;
@@ -196,7 +206,8 @@ const CommandRegistration registration{
                                  {"translation_mm", stats_json(summary.translation_mm)},
                                  {"reprojection_px", stats_json(summary.reprojection_px)},
                                  {"against", reference->empty() ? "gt.csv" : *reference},
-                                 {"corners", corner_json}};
+                                 {"corners", corner_json},
+                                 {"line_selection", line_json}};
           std::cout << j.dump() << std::endl;
         } else {
           print_human(*seq_dir, summary, ignored);
@@ -206,6 +217,10 @@ const CommandRegistration registration{
                           c["max_px"].get<double>());
             else
               std::printf("corners frame %d   no estimate (lost or absent)\n", c["frame"].get<int>());
+          if (!line_json.is_null())
+            std::printf("line selection   %.1f %% right of %d; edges with a close parallel neighbour %.1f %% of %d\n",
+                        100 * line_json["right_rate"].get<double>(), line_json["selections"].get<int>(),
+                        100 * line_json["crowded_right_rate"].get<double>(), line_json["crowded_selections"].get<int>());
         }
         return 0;
       };

@@ -1,12 +1,14 @@
 // `epichead track SEQ --out DIR [--mode gradient|epic|epic+validation] [--imu off|on]`: the full
 // model-based tracker over a sequence. Writes DIR/poses.csv (gt.csv columns + status),
-// DIR/report.json (summary + per-frame stage timings and feature counts), overlays every Nth
+// DIR/report.json (summary + per-frame stage timings and feature counts), DIR/lines.csv (the
+// candidate selected for each visible edge, for `score --lines`), overlays every Nth
 // frame as DIR/overlay_NNNNNN.png and the whole run as DIR/overlay.mp4.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 #include <fstream>
 #include <map>
 
@@ -31,6 +33,8 @@ using namespace epichead::vision;
 struct TrackArgs {
   std::string seq, out, mode = "epic+validation", imu = "off";
   int every = 30;
+  std::vector<int> zoom;  // x, y, w, h: PNG overlays show this region, enlarged
+
   int max_frames = 0;
   bool video = true;
   double crease_deg = 20.0;
@@ -39,6 +43,33 @@ struct TrackArgs {
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
 // (yellow), junctions (cyan), and the model at the estimated pose (thin, by ObjectSide colour).
+// The candidate the tracker chose for a feature before the pose judged it: validation's pick, or
+// without validation the strongest (the tracker marks a pose outlier unselected afterwards, so
+// f.selected alone would hide the wrong choices).
+int chosen_candidate(const ModelTracker& tracker, const LineFeature& f) {
+  if (tracker.options().mode == TrackMode::EpicValidation) return tracker.validation().selected[static_cast<std::size_t>(f.edge)];
+  return f.result.candidates.empty() ? -1 : 0;
+}
+
+// One row per visible edge: the selected candidate's end points (found = 0: none selected) and
+// whether the pose kept it as an inlier.
+void write_selected_lines(std::ofstream& out, const ModelTracker& tracker, const FrameReport& report, int frame_number) {
+  const auto& residuals = tracker.pose().residuals;
+  char row[192];
+  for (const LineFeature& f : tracker.lines().features()) {
+    if (!f.visible) continue;
+    const int chosen = chosen_candidate(tracker, f);
+    const auto& cands = f.result.candidates;
+    const bool found = chosen >= 0 && chosen < static_cast<int>(cands.size());
+    const bool inlier = found && report.status != TrackStatus::Lost && static_cast<std::size_t>(f.edge) < residuals.size() &&
+                        residuals[static_cast<std::size_t>(f.edge)].inlier;
+    const LineCandidate c = found ? cands[static_cast<std::size_t>(chosen)] : LineCandidate{};
+    std::snprintf(row, sizeof row, "%d,%d,%d,%zu,%.2f,%.2f,%.2f,%.2f,%d\n", frame_number, f.edge, found ? 1 : 0, cands.size(),
+                  c.a_px.x(), c.a_px.y(), c.b_px.x(), c.b_px.y(), inlier ? 1 : 0);
+    out << row;
+  }
+}
+
 void draw_frame(cv::Mat& canvas, const ModelTracker& tracker, const FrameReport& report, const VisibleModel& at_estimate,
                 int frame_number, const std::string& mode) {
   constexpr int shift = 4;
@@ -53,7 +84,7 @@ void draw_frame(cv::Mat& canvas, const ModelTracker& tracker, const FrameReport&
     const double x0 = g.x_of_col(0), x1 = g.x_of_col(g.cols - 1), s0 = g.s_of_row(0), s1 = g.s_of_row(g.rows - 1);
     const std::vector<cv::Point> quad{P(g.to_image(x0, s0)), P(g.to_image(x1, s0)), P(g.to_image(x1, s1)), P(g.to_image(x0, s1))};
     cv::polylines(canvas, quad, true, cv::Scalar(110, 110, 110), 1, cv::LINE_AA, shift);
-    const int chosen = validated ? tracker.validation().selected[static_cast<std::size_t>(f.edge)] : f.selected;
+    const int chosen = chosen_candidate(tracker, f);
     for (int c = 0; c < static_cast<int>(f.result.candidates.size()); ++c) {
       const LineCandidate& cand = f.result.candidates[static_cast<std::size_t>(c)];
       if (c == chosen) {
@@ -127,6 +158,13 @@ int run_track(const TrackArgs& args) {
   const std::string video_path = (fs::path(args.out) / "overlay.mp4").string();
   std::string video_note;
 
+  // Per frame and visible model edge, the candidate the tracker selected: what `epichead score
+  // --lines` checks against the ground truth (did the tracker pick the right edge?).
+  const std::string lines_path = (fs::path(args.out) / "lines.csv").string();
+  std::ofstream lines_csv(lines_path);
+  if (!lines_csv) return fail(cmd, "cannot write " + lines_path);
+  lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n";
+
   std::vector<StampedPose> poses;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
@@ -169,6 +207,8 @@ int run_track(const TrackArgs& args) {
                          {"scale_px", report.scale_px},
                          {"pose_iterations", report.pose_iterations}});
 
+    write_selected_lines(lines_csv, tracker, report, entry.frame);
+
     const bool png = args.every > 0 && (i % static_cast<std::size_t>(args.every) == 0 || i + 1 == n);
     if (png || args.video) {
       cv::Mat canvas;
@@ -181,8 +221,19 @@ int run_track(const TrackArgs& args) {
         char name[64];
         std::snprintf(name, sizeof name, "overlay_%06d.png", entry.frame);
         const std::string path = (fs::path(args.out) / name).string();
+        cv::Mat png_image = canvas;
+        if (!args.zoom.empty()) {
+          // A close-up (the paper's Figs. 18/19 show the stiffeners this way): the region twice
+          // as large, pixels kept sharp, captioned with the frame and mode.
+          const cv::Rect region = cv::Rect(args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]) & cv::Rect(0, 0, canvas.cols, canvas.rows);
+          if (region.area() == 0) return fail(cmd, "--zoom lies outside the " + std::to_string(canvas.cols) + "x" + std::to_string(canvas.rows) + " image");
+          cv::resize(canvas(region), png_image, {}, 2, 2, cv::INTER_NEAREST);
+          const std::string caption = "frame " + std::to_string(entry.frame) + "  " + args.mode;
+          cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 0, 0}, 3, cv::LINE_AA);
+          cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {255, 255, 255}, 1, cv::LINE_AA);
+        }
         try {
-          if (!cv::imwrite(path, canvas)) return fail(cmd, "cannot write " + path);
+          if (!cv::imwrite(path, png_image)) return fail(cmd, "cannot write " + path);
         } catch (const cv::Exception& e) {
           return fail(cmd, "cannot write " + path + ": " + e.what());
         }
@@ -246,6 +297,10 @@ const CommandRegistration registration{
                      "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset), s, or 'auto' "
                      "(default: estimated from the gyro and the tracked poses once the camera has turned enough)");
       app.add_flag("!--no-video", a->video, "Do not write overlay.mp4");
+      app.add_option("--zoom", a->zoom, "PNG overlays show only this region (X,Y,W,H pixels), enlarged twice")
+          ->delimiter(',')
+          ->expected(4)
+          ->check(CLI::NonNegativeNumber);
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
       return [a]() { return run_track(*a); };
     }};

@@ -15,6 +15,7 @@
 
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/visibility.h"
 #include "common/temp_dir.h"
 
 using namespace epichead::vision;
@@ -214,4 +215,43 @@ TEST_CASE("score --help describes the command and exits 0") {
   const Run r = score(tmp, "--help");
   CHECK(r.exit_code == 0);
   CHECK_THAT(r.out, Catch::Contains("--sym-axis") && Catch::Contains("--per-frame") && Catch::Contains("--json"));
+}
+
+TEST_CASE("score --lines counts a selection right on the true edge and wrong when it is a parallel line 10 px away") {
+  TempDir tmp;
+  const std::string seq_dir = make_sequence(tmp);
+  auto seq = Sequence::open(seq_dir);
+  REQUIRE(seq);
+  // For every visible cube edge: the true projection (right) in even frames, the same line
+  // moved 10 px sideways (wrong) in odd frames.
+  Visibility visibility(seq->model(), seq->camera());
+  VisibleModel vis;
+  std::ofstream lines(tmp / "lines.csv");
+  lines << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n";
+  int even = 0, odd = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    visibility.compute(pose_at(i).cam_T_obj, vis);
+    for (const auto& e : vis.edges) {
+      Eigen::Vector2d n(-(e.b_px - e.a_px).y(), (e.b_px - e.a_px).x());
+      n.normalize();
+      const Eigen::Vector2d shift = i % 2 ? Eigen::Vector2d(10 * n) : Eigen::Vector2d::Zero();
+      lines << i << ',' << e.edge << ",1,2," << (e.a_px + shift).x() << ',' << (e.a_px + shift).y() << ','
+            << (e.b_px + shift).x() << ',' << (e.b_px + shift).y() << ",1\n";
+      (i % 2 ? odd : even) += 1;
+    }
+  }
+  lines.close();
+  REQUIRE(even > 0);
+  REQUIRE(odd > 0);
+  const Run r = score(tmp, q(seq_dir) + " " + q(make_estimates(tmp)) + " --json --lines " + q(tmp / "lines.csv"));
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto ls = nlohmann::json::parse(r.out).at("line_selection");
+  CHECK(ls.at("selections") == even + odd);
+  CHECK(ls.at("right_rate").get<double>() == Approx(static_cast<double>(even) / (even + odd)));
+
+  std::ofstream(tmp / "bad.csv") << "frame,edge\n1,2\n";
+  const Run bad = score(tmp, q(seq_dir) + " " + q(make_estimates(tmp)) + " --lines " + q(tmp / "bad.csv"));
+  CHECK(bad.exit_code != 0);
+  CHECK(bad.err.find("bad.csv") != std::string::npos);
 }
