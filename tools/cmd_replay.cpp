@@ -90,7 +90,7 @@ const CommandRegistration registration{
       auto o = std::make_shared<Options>();
       app.add_option("LOG", o->log, "candump log (candump -l format, or candump's default output)")->required();
       app.add_flag("--json", o->json, "Print one JSON object instead of the text report");
-      app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png into this directory");
+      app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png and attitude.png into this directory");
       app.add_option("--bitrate", o->bitrate, "Nominal bus bit rate for the bus load, bit/s (default 500000)");
       app.add_option("--data-bitrate", o->data_bitrate, "CAN FD data-phase bit rate, bit/s (default 2000000)");
       app.add_option("--imu-protocol", o->imu_protocol,
