@@ -4,6 +4,7 @@
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
+#include "epichead/vision/pose_covariance.h"
 
 namespace epichead::tools {
 namespace {
@@ -63,9 +64,7 @@ class ImuPredictor final : public TrackPredictor {
   Eigen::Isometry3d predict(double t_s) override {
     feed_until(t_s);
     if (pending_init_) {
-      fusion::Matrix6d cov = fusion::Matrix6d::Zero();
-      cov.diagonal() << 1e-4, 1e-4, 1e-4, 3e-4, 3e-4, 3e-4;  // 1 cm, 1 deg: init.csv's accuracy
-      const auto r = predictor_.add_vision(init_t_s_, last_good_, cov);
+      const auto r = predictor_.add_vision(init_t_s_, last_good_, vision::initial_pose_covariance());
       pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
     }
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
@@ -93,9 +92,7 @@ class ImuPredictor final : public TrackPredictor {
         if (const auto e = estimator_->estimate()) return adopt(*e, t_s, report);
       }
     }
-    // The estimator's covariance assumes independent edgels; neighbouring edgels of one blurred
-    // edge are not, so it is optimistic by about the number of edgels per line: inflate it.
-    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, kCovarianceInflation * report.covariance);
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
     if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld) pending_init_ = false;
   }
   nlohmann::json diagnostics() const override {
@@ -127,7 +124,6 @@ class ImuPredictor final : public TrackPredictor {
 
  private:
   static constexpr double kLostResetS = 1.0;
-  static constexpr double kCovarianceInflation = 10.0;
   static constexpr int kFitEveryFrames = 10;
   void feed_until(double t_s) {
     const auto& imu = *imu_;
@@ -163,7 +159,7 @@ class ImuPredictor final : public TrackPredictor {
     next_ = 0;
     while (next_ < imu.size() && imu[next_].t_s - offset_s_ < t_s - options_.gravity_average_s - 0.05) ++next_;
     feed_until(t_s);
-    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, kCovarianceInflation * report.covariance);
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
     init_t_s_ = t_s;
   }

@@ -13,6 +13,7 @@
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
 #include "epichead/vision/window_image.h"
+#include "epichead/vision/pose_covariance.h"
 #include "recent_samples.h"
 
 namespace epichead::head {
@@ -165,9 +166,7 @@ struct OnboardLoop::Impl {
     }
     const double exposure = frame.t_s;
     if (init_pending) {
-      fusion::Matrix6d cov = fusion::Matrix6d::Zero();
-      cov.diagonal() << 1e-4, 1e-4, 1e-4, 3e-4, 3e-4, 3e-4;  // 1 cm, 1 deg
-      const auto v = predictor.add_vision(init_t_s, last_good, cov).verdict;
+      const auto v = predictor.add_vision(init_t_s, last_good, vision::initial_pose_covariance()).verdict;
       init_pending = v != fusion::VisionVerdict::Initialised && v != fusion::VisionVerdict::Applied;
     }
     const auto prediction = predictor.predict(exposure);
@@ -190,8 +189,7 @@ struct OnboardLoop::Impl {
     last_status = pending.status;
     if (pending.status == vision::TrackStatus::Lost) return;  // the controller's watchdog sees the target go stale
     last_good = pending.cam_T_obj;
-    // Edgels of one blurred edge are correlated: the estimator's covariance is optimistic.
-    predictor.add_vision(pending.exposure_t_s, pending.cam_T_obj, 10.0 * pending.covariance);
+    predictor.add_vision(pending.exposure_t_s, pending.cam_T_obj, vision::kTrackedPoseCovarianceInflation * pending.covariance);
     target = target_from_pose(pending.exposure_t_s, pending.cam_T_obj, target_point_obj);
     target_exposure_t_s = pending.exposure_t_s;
     target_publish_t_s = pending.publish_t_s;
