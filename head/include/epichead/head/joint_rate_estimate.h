@@ -17,7 +17,7 @@
 namespace epichead::head {
 
 struct JointRateEstimateOptions {
-  double command_delay_s = 0.001;         // command sent -> joints start moving to its rate (bus + firmware)
+  double command_delay_s = 0.0005;        // command sent -> joints start moving to its rate (bus + firmware)
   double motor_lag_s = 0;                 // then the joint rate follows with this first-order lag
   double correction_time_constant_s = 0.05;  // measured-vs-commanded correction's low-pass
   double max_command_age_s = 0.05;        // an older command says nothing about now: use the measurement
