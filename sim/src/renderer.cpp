@@ -1,9 +1,10 @@
 // The simulator's renderer. Why it is hand-written: OpenCV's fillPoly has no depth buffer, no
 // sub-pixel anti-aliasing and no perspective-correct attributes, and a GL context is not
 // available on a headless robot or in CI. Per frame:
-//   1. environment (photos on far walls, the floor) at pixel resolution: one warpPerspective per
-//      visible plane (a plane maps by a homography), cast shadows as filled polygons; drawn at
-//      as few instants of the exposure as its own image motion needs, averaged;
+//   1. environment (photos on far walls, the floor) at pixel resolution: each visible plane
+//      warped along its polygon's row spans (a plane maps by a homography), cast shadows as
+//      filled polygons; drawn at as few instants of the exposure as its own image motion needs,
+//      averaged, row by row over all instants (render_environment.h);
 //   2. per sub-frame, objects (tracked object, scenery, occluders) rasterised exactly
 //      (fixed-point edge functions, top-left rule) at several sub-pixel sample positions with a
 //      depth buffer, tile by tile, shaded once per pixel and triangle (multisampling); each
@@ -15,61 +16,44 @@
 // map's 1/32 px).
 #include "epichead/sim/renderer.h"
 
+#include "render_clip.h"
+#include "render_environment.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <numeric>
+#include <optional>
+#include <cstring>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
+#if defined(__SSE4_1__)
+#include <smmintrin.h>
+#endif
+
 namespace epichead::sim {
 namespace {
+
+using render::ClipPlane;
+using render::Vertex;
+using render::clip_polygon;
 
 constexpr int kFixShift = 8;                    // vertices snap to 1/256 px
 constexpr std::int64_t kFixOne = std::int64_t{1} << kFixShift;
 constexpr int kMaxSamplesPerSubframe = 16;
 constexpr int kMaxSamplesPerFrame = 256;
-constexpr double kGuardBandPx = 4096;           // triangles are clipped this far outside the image
-constexpr double kEnvStepPx = 1.0;
-constexpr int kTile = 64;                       // object tiles: 64 x 64 pixels              // largest environment motion between its blur copies
+constexpr double kEnvStepPx = 1.0;              // largest environment motion between its blur copies
+constexpr int kTile = 64;                       // object tiles: 64 x 64 pixels
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   return a >= 0 ? a / b : -((-a + b - 1) / b);
 }
 std::int64_t ceil_div(std::int64_t a, std::int64_t b) {   // b > 0
   return a >= 0 ? (a + b - 1) / b : -((-a) / b);
-}
-
-struct Vertex {  // a vertex in the camera frame with its attributes, before and during clipping
-  Eigen::Vector3f p;
-  float shade = 1, u = 0, v = 0;
-};
-
-Vertex lerp(const Vertex& a, const Vertex& b, float s) {
-  return {a.p + s * (b.p - a.p), a.shade + s * (b.shade - a.shade), a.u + s * (b.u - a.u), a.v + s * (b.v - a.v)};
-}
-
-// A clip plane n . p + d >= 0 in the camera frame.
-struct ClipPlane {
-  Eigen::Vector3f n;
-  float d;
-  float eval(const Eigen::Vector3f& p) const { return n.dot(p) + d; }
-};
-
-// Sutherland-Hodgman against one plane; `in` and `out` hold up to 3 + planes vertices.
-int clip_polygon(const Vertex* in, int n_in, const ClipPlane& plane, Vertex* out) {
-  int n_out = 0;
-  for (int i = 0; i < n_in; ++i) {
-    const Vertex& a = in[i];
-    const Vertex& b = in[(i + 1) % n_in];
-    const float da = plane.eval(a.p), db = plane.eval(b.p);
-    if (da >= 0) out[n_out++] = a;
-    if ((da >= 0) != (db >= 0)) out[n_out++] = lerp(a, b, da / (da - db));
-  }
-  return n_out;
 }
 
 // Per-frame material data: everything that varies with time folded in once.
@@ -161,8 +145,6 @@ struct Renderer::Impl {
     float inv_cols = 1, inv_rows = 1;  // 1 / size, for wrapping
   };
   std::vector<std::vector<MipLevel>> tex_mips;
-  std::vector<cv::Mat> env_tex8;    // per environment plane: tinted 8-bit texture (empty: plain)
-  std::vector<cv::Vec3b> env_plain8;
   float decode_lut[256];
   static constexpr int kDecodeFine = 4;  // steps per grey level of the filtered-texel decode table
   float decode_fine[255 * kDecodeFine + 2];
@@ -175,16 +157,14 @@ struct Renderer::Impl {
   std::vector<float> depth;         // kTile^2 pixels of M samples: 1/z, 0 = empty
   std::vector<float> color;         // kTile^2 pixels of M samples of 3 channels
   std::vector<float> env_linear;    // W*H*3
-  cv::Mat env8, receiver_mask, shadow_mask;
   cv::Mat corr, encoded, remapped;  // CV_32FC3: object minus environment, gamma-encoded, distorted
   cv::Rect corr_box;                 // where corr holds this frame's values
   std::vector<RasterTriangle> tris;
   std::vector<FrameMaterial> materials;
   std::vector<std::vector<Eigen::Vector2i>> patterns;  // by total sample count
-  Eigen::Vector2d poly_f[12];       // the last projected polygon, pixels
-  int poly_n = 0;
-  std::vector<uchar> blur_line;
-  ClipPlane clip_planes[5];
+  render::ClipPlane clip_planes[5];
+  std::optional<render::EnvironmentLayer> environment;
+  std::vector<render::EnvironmentInstant> env_instants;
 
   Impl(Scene s, const vision::Camera& cam, const RenderOptions& o) : scene(std::move(s)), camera(cam), opt(o) {
     validate();
@@ -196,9 +176,6 @@ struct Renderer::Impl {
     depth.assign(static_cast<std::size_t>(kTile * kTile * M), 0.f);
     color.assign(static_cast<std::size_t>(kTile * kTile * M * 3), 0.f);
     env_linear.assign(n * 3, 0.f);
-    env8.create(H, W, CV_8UC3);
-    receiver_mask.create(H, W, CV_8U);
-    shadow_mask = cv::Mat::zeros(H, W, CV_8U);  // kept zero outside the shadows being drawn
     corr.create(H, W, CV_32FC3);
     encoded.create(H, W, CV_32FC3);
     if (distort) remapped.create(camera.height_px(), camera.width_px(), CV_32FC3);
@@ -208,16 +185,13 @@ struct Renderer::Impl {
     tris.reserve(3 * triangles + 16);
     materials.resize(scene.materials.size());
     patterns.resize(kMaxSamplesPerFrame + 1);
-    blur_line.reserve(static_cast<std::size_t>(std::max(W, H)));
     // Clip planes: near, and a guard band around the ideal image (keeps fixed point in range).
-    const float gx = static_cast<float>(kGuardBandPx / fx), gy = static_cast<float>(kGuardBandPx / fy);
-    const float xl = static_cast<float>(-cx / fx) - gx, xr = static_cast<float>((W - cx) / fx) + gx;
-    const float yt = static_cast<float>(-cy / fy) - gy, yb = static_cast<float>((H - cy) / fy) + gy;
-    clip_planes[0] = {{0, 0, 1}, -static_cast<float>(opt.near_m)};
-    clip_planes[1] = {{1, 0, -xl}, 0};   // x/z >= xl
-    clip_planes[2] = {{-1, 0, xr}, 0};   // x/z <= xr
-    clip_planes[3] = {{0, 1, -yt}, 0};
-    clip_planes[4] = {{0, -1, yb}, 0};
+    render::IdealView view;
+    view.W = W; view.H = H; view.fx = fx; view.fy = fy; view.cx = cx; view.cy = cy;
+    view.set_clip_planes(opt.near_m);
+    std::copy(std::begin(view.clip_planes), std::end(view.clip_planes), clip_planes);
+    environment.emplace(scene, view, opt.gamma > 0 ? opt.gamma : 1.0, decode_lut);
+    env_instants.reserve(16);
   }
 
   void validate() const {
@@ -340,41 +314,6 @@ struct Renderer::Impl {
                         1.f / static_cast<float>(half.rows)});
       }
     }
-    auto encode8 = [&](float lin) {
-      const double g = opt.gamma > 0 ? opt.gamma : 1.0;
-      return cv::saturate_cast<uchar>(255.0 * std::pow(std::clamp(static_cast<double>(lin), 0.0, 1.0), 1.0 / g));
-    };
-    for (const auto& plane : scene.background.planes) {
-      if (plane.texture < 0) {
-        env_tex8.emplace_back();
-        env_plain8.push_back({encode8(plane.tint_bgr[0]), encode8(plane.tint_bgr[1]), encode8(plane.tint_bgr[2])});
-        continue;
-      }
-      cv::Mat t8 = scene.textures[static_cast<std::size_t>(plane.texture)];
-      if (plane.tex_px_per_m > 0) {
-        // Repeat the texture over the whole plane once here: warpPerspective's BORDER_WRAP takes
-        // a slow per-pixel path, BORDER_REPLICATE on a stretched texture does not.
-        const double scale = std::min(1.0, 4096.0 / (std::max(plane.width_m, plane.height_m) * plane.tex_px_per_m));
-        const int w = std::max(1, static_cast<int>(std::lround(plane.width_m * plane.tex_px_per_m * scale)));
-        const int h = std::max(1, static_cast<int>(std::lround(plane.height_m * plane.tex_px_per_m * scale)));
-        cv::Mat tile = t8;
-        if (scale < 1) cv::resize(t8, tile, cv::Size(), scale, scale, cv::INTER_AREA);
-        cv::Mat tiled;
-        cv::repeat(tile, h / tile.rows + 1, w / tile.cols + 1, tiled);
-        t8 = tiled(cv::Rect(0, 0, w, h));
-      }
-      // Tint in linear light, back to 8-bit: one table per channel.
-      cv::Mat lut(1, 256, CV_8UC3);
-      for (int i = 0; i < 256; ++i)
-        for (int ch = 0; ch < 3; ++ch) lut.at<cv::Vec3b>(0, i)[ch] = encode8(decode_lut[i] * plane.tint_bgr[ch]);
-      cv::Mat tinted;
-      cv::LUT(t8, lut, tinted);
-      env_tex8.push_back(tinted);
-      env_plain8.push_back({0, 0, 0});
-    }
-    cv::Vec3b plain{encode8(scene.background.plain_bgr[0]), encode8(scene.background.plain_bgr[1]),
-                    encode8(scene.background.plain_bgr[2])};
-    env_plain8.push_back(plain);  // last entry: the plain background
   }
 
   const std::vector<Eigen::Vector2i>& pattern(int total) {
@@ -631,248 +570,30 @@ struct Renderer::Impl {
     const float w00 = (1 - au) * (1 - av) * kDecodeFine, w01 = au * (1 - av) * kDecodeFine;
     const float w10 = (1 - au) * av * kDecodeFine, w11 = au * av * kDecodeFine;
     cv::Vec3f out;
+#if defined(__SSE4_1__)
+    // All channels of a texel at once; the same operations in the same order as the scalar code.
+    auto texel = [](const uchar* p) {
+      std::int32_t bgra = 0;
+      std::memcpy(&bgra, p, 4);
+      return _mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(bgra)));
+    };
+    __m128 e = _mm_mul_ps(_mm_set1_ps(w00), texel(p00));
+    e = _mm_add_ps(e, _mm_mul_ps(_mm_set1_ps(w01), texel(p01)));
+    e = _mm_add_ps(e, _mm_mul_ps(_mm_set1_ps(w10), texel(p10)));
+    e = _mm_add_ps(e, _mm_mul_ps(_mm_set1_ps(w11), texel(p11)));
+    alignas(16) std::int32_t idx[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(_mm_add_ps(e, _mm_set1_ps(0.5f))));
+    for (int ch = 0; ch < 3; ++ch) out[ch] = decode[idx[ch]];
+#else
     for (int ch = 0; ch < 3; ++ch) {
       const float e = w00 * p00[ch] + w01 * p01[ch] + w10 * p10[ch] + w11 * p11[ch];
       out[ch] = decode[static_cast<int>(e + 0.5f)];
     }
+#endif
     return out;
   }
 
-  // ---- environment -------------------------------------------------------------------------
-
-  // Projects a convex 3D polygon (camera frame) after near/guard clipping into poly_f, with its
-  // pixel bounding box; false when not visible.
-  bool project_polygon(const Eigen::Vector3f* corners, int n, cv::Rect& box) {
-    Vertex a[12], b[12];
-    for (int i = 0; i < n; ++i) a[i].p = corners[i];
-    Vertex* in = a;
-    Vertex* o = b;
-    for (const auto& plane : clip_planes) {
-      n = clip_polygon(in, n, plane, o);
-      if (n < 3) return false;
-      std::swap(in, o);
-    }
-    poly_n = n;
-    float xmin = 1e30f, ymin = 1e30f, xmax = -1e30f, ymax = -1e30f;
-    for (int i = 0; i < n; ++i) {
-      const float x = static_cast<float>(fx) * in[i].p.x() / in[i].p.z() + static_cast<float>(cx);
-      const float y = static_cast<float>(fy) * in[i].p.y() / in[i].p.z() + static_cast<float>(cy);
-      if (!std::isfinite(x) || !std::isfinite(y)) return false;
-      poly_f[i] = {x, y};
-      xmin = std::min(xmin, x); xmax = std::max(xmax, x); ymin = std::min(ymin, y); ymax = std::max(ymax, y);
-    }
-    const int x0 = std::max(0, static_cast<int>(std::floor(xmin)) - 1), y0 = std::max(0, static_cast<int>(std::floor(ymin)) - 1);
-    const int x1 = std::min(W, static_cast<int>(std::ceil(xmax)) + 2), y1 = std::min(H, static_cast<int>(std::ceil(ymax)) + 2);
-    if (x0 >= x1 || y0 >= y1) return false;
-    box = cv::Rect(x0, y0, x1 - x0, y1 - y0);
-    return true;
-  }
-
-  [[gnu::noinline]] void render_environment(const Eigen::Isometry3d& cam_T_world, bool shadows_on) {
-    const cv::Vec3b plain = env_plain8.back();
-    // (Plain loops: Mat::setTo allocates.)
-    for (int y = 0; y < H; ++y) {
-      uchar* row = env8.ptr<uchar>(y);
-      for (int x = 0; x < W; ++x) { row[3 * x] = plain[0]; row[3 * x + 1] = plain[1]; row[3 * x + 2] = plain[2]; }
-      if (shadows_on) std::fill(receiver_mask.ptr<uchar>(y), receiver_mask.ptr<uchar>(y) + W, uchar{0});
-    }
-    const auto& planes = scene.background.planes;
-    const Eigen::Matrix3d K = (Eigen::Matrix3d() << fx, 0, cx, 0, fy, cy, 0, 0, 1).finished();
-    for (std::size_t i = 0; i < planes.size(); ++i) {
-      const EnvironmentPlane& p = planes[i];
-      const Eigen::Isometry3d cam_T_plane = cam_T_world * p.world_T_plane;
-      const double hw = p.width_m / 2, hh = p.height_m / 2;
-      Eigen::Vector3f corners[4];
-      const double cs[4][2] = {{-hw, -hh}, {hw, -hh}, {hw, hh}, {-hw, hh}};
-      for (int k = 0; k < 4; ++k) corners[k] = (cam_T_plane * Eigen::Vector3d(cs[k][0], cs[k][1], 0)).cast<float>();
-      // The plane is seen only from its +z side.
-      if (cam_T_plane.linear().col(2).dot(cam_T_plane.translation()) >= 0) continue;
-      cv::Rect box;
-      if (!project_polygon(corners, 4, box)) continue;
-      // Hand-written warp (why: cv::warpPerspective allocates per block, and the polygon's row
-      // spans replace a mask and a masked copy).
-      const cv::Mat& tex = env_tex8[i];
-      Eigen::Matrix3d tex_from_px = Eigen::Matrix3d::Zero();
-      if (!tex.empty()) {
-        // Ideal pixel -> plane (s, t) -> texture pixel.
-        Eigen::Matrix3d px_from_st;
-        px_from_st.col(0) = K * cam_T_plane.linear().col(0);
-        px_from_st.col(1) = K * cam_T_plane.linear().col(1);
-        px_from_st.col(2) = K * cam_T_plane.translation();
-        // (Repeating textures were expanded over the whole plane in setup_textures.)
-        const double su = tex.cols / p.width_m, sv = tex.rows / p.height_m;
-        Eigen::Matrix3d tex_from_st;
-        tex_from_st << su, 0, hw * su - 0.5, 0, -sv, hh * sv - 0.5, 0, 0, 1;
-        tex_from_px = tex_from_st * px_from_st.inverse();
-        if (!tex_from_px.allFinite()) continue;
-      }
-      const cv::Vec3b plain_i = env_plain8[i];
-      const float umax = static_cast<float>(tex.cols - 1) - 1e-3f, vmax = static_cast<float>(tex.rows - 1) - 1e-3f;
-      for (int y = box.y; y < box.y + box.height; ++y) {
-        int x0 = 0, x1 = 0;
-        if (!row_span(y, x0, x1)) continue;
-        uchar* dst = env8.ptr<uchar>(y);
-        if (shadows_on) std::fill(receiver_mask.ptr<uchar>(y) + x0, receiver_mask.ptr<uchar>(y) + x1 + 1, p.receives_shadow ? 255 : 0);
-        if (tex.empty()) {
-          for (int x = x0; x <= x1; ++x) {
-            dst[3 * x] = plain_i[0]; dst[3 * x + 1] = plain_i[1]; dst[3 * x + 2] = plain_i[2];
-          }
-          continue;
-        }
-        Eigen::Vector3d h = tex_from_px * Eigen::Vector3d(x0, y, 1);
-        const Eigen::Vector3d step = tex_from_px.col(0);
-        for (int x = x0; x <= x1; ++x, h += step) {
-          const double inv = 1.0 / h.z();
-          const float u = std::clamp(static_cast<float>(h.x() * inv), 0.f, umax);
-          const float v = std::clamp(static_cast<float>(h.y() * inv), 0.f, vmax);
-          const int iu = static_cast<int>(u), iv = static_cast<int>(v);
-          const int au = static_cast<int>((u - static_cast<float>(iu)) * 256), av = static_cast<int>((v - static_cast<float>(iv)) * 256);
-          const uchar* r0 = tex.ptr<uchar>(iv) + 3 * iu;
-          const uchar* r1 = tex.ptr<uchar>(iv + 1) + 3 * iu;
-          for (int ch = 0; ch < 3; ++ch) {
-            const int top = r0[ch] * (256 - au) + r0[ch + 3] * au, bottom = r1[ch] * (256 - au) + r1[ch + 3] * au;
-            dst[3 * x + ch] = static_cast<uchar>((top * (256 - av) + bottom * av + (1 << 15)) >> 16);
-          }
-        }
-      }
-    }
-  }
-
-  // The pixels of row y whose centres lie inside the last projected polygon (poly_f): [x0, x1].
-  bool row_span(int y, int& x0, int& x1) const {
-    double lo = 1e300, hi = -1e300;
-    const double yc = y;
-    for (int i = 0; i < poly_n; ++i) {
-      const Eigen::Vector2d& a = poly_f[i];
-      const Eigen::Vector2d& b = poly_f[(i + 1) % poly_n];
-      if ((a.y() <= yc) == (b.y() <= yc)) continue;
-      const double x = a.x() + (yc - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-    if (!(lo <= hi)) return false;
-    x0 = static_cast<int>(std::max(0.0, std::ceil(lo)));
-    x1 = static_cast<int>(std::min(static_cast<double>(W - 1), std::ceil(hi) - 1));
-    return x0 <= x1;
-  }
-
-  // Separable box blur, twice (close to a Gaussian of sigma_px), of a mask region, in place.
-  void soften(cv::Mat& mask, const cv::Rect& r, double sigma_px) {
-    const int radius = std::max(1, static_cast<int>(std::lround((std::sqrt(6 * sigma_px * sigma_px + 1) - 1) / 2)));
-    const int n = 2 * radius + 1;
-    blur_line.resize(static_cast<std::size_t>(std::max(r.width, r.height)));
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int y = r.y; y < r.y + r.height; ++y) {  // rows
-        uchar* m = mask.ptr<uchar>(y) + r.x;
-        for (int x = 0; x < r.width; ++x) blur_line[static_cast<std::size_t>(x)] = m[x];
-        int sum = 0;
-        for (int k = -radius; k <= radius; ++k) sum += blur_line[static_cast<std::size_t>(std::clamp(k, 0, r.width - 1))];
-        for (int x = 0; x < r.width; ++x) {
-          m[x] = static_cast<uchar>((sum + n / 2) / n);
-          sum += blur_line[static_cast<std::size_t>(std::min(x + radius + 1, r.width - 1))] -
-                 blur_line[static_cast<std::size_t>(std::max(x - radius, 0))];
-        }
-      }
-      for (int x = r.x; x < r.x + r.width; ++x) {  // columns
-        for (int y = 0; y < r.height; ++y) blur_line[static_cast<std::size_t>(y)] = mask.at<uchar>(r.y + y, x);
-        int sum = 0;
-        for (int k = -radius; k <= radius; ++k) sum += blur_line[static_cast<std::size_t>(std::clamp(k, 0, r.height - 1))];
-        for (int y = 0; y < r.height; ++y) {
-          mask.at<uchar>(r.y + y, x) = static_cast<uchar>((sum + n / 2) / n);
-          sum += blur_line[static_cast<std::size_t>(std::min(y + radius + 1, r.height - 1))] -
-                 blur_line[static_cast<std::size_t>(std::max(y - radius, 0))];
-        }
-      }
-    }
-  }
-
-  // Shadow of one posed mesh on the ground plane, filled into shadow_mask; grows `box`.
-  void add_shadow(const Mesh& mesh, const Eigen::Isometry3d& world_T_mesh, const Eigen::Isometry3d& cam_T_world, cv::Rect& box) {
-    const Eigen::Vector3d l = scene.light.direction_world.normalized();
-    if (l.z() < 0.05) return;
-    const double g = scene.shadows.ground_z_m;
-    const Eigen::Vector3f light_mesh = (world_T_mesh.linear().transpose() * l).cast<float>();
-    for (const auto& tri : mesh.triangles) {
-      const Eigen::Vector3f& p0 = mesh.positions[static_cast<std::size_t>(tri[0])];
-      const Eigen::Vector3f& p1 = mesh.positions[static_cast<std::size_t>(tri[1])];
-      const Eigen::Vector3f& p2 = mesh.positions[static_cast<std::size_t>(tri[2])];
-      // A closed solid's shadow is the union of the shadows of its faces toward the light.
-      if (mesh.closed && (p1 - p0).cross(p2 - p0).dot(light_mesh) <= 0) continue;
-      Eigen::Vector3f c[3];
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d pw = world_T_mesh * mesh.positions[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])].cast<double>();
-        const Eigen::Vector3d on_ground = pw - std::max(0.0, pw.z() - g) / l.z() * l;
-        c[k] = (cam_T_world * on_ground).cast<float>();
-      }
-      cv::Rect b;
-      if (!project_polygon(c, 3, b)) continue;
-      for (int y = b.y; y < b.y + b.height; ++y) {
-        int x0 = 0, x1 = 0;
-        if (row_span(y, x0, x1)) std::fill(shadow_mask.ptr<uchar>(y) + x0, shadow_mask.ptr<uchar>(y) + x1 + 1, uchar{255});
-      }
-      box = box.area() == 0 ? b : (box | b);
-    }
-  }
-
-  // Decodes the environment to linear light (darkening shadowed floor) and adds it with
-  // `weight` to env_linear (assigns when `first`).
-  [[gnu::noinline]] void environment_to_linear(bool shadows_on, const cv::Rect& shadow_box, bool first, float weight) {
-    const Eigen::Vector3d l = scene.light.direction_world.normalized();
-    const double lit = scene.light.ambient + scene.light.diffuse * std::max(0.0, l.z());
-    const float keep = lit > 0 ? static_cast<float>(scene.light.ambient / lit) : 1.f;
-    float lut[256];
-    for (int i = 0; i < 256; ++i) lut[i] = weight * decode_lut[i];
-    const bool shadow_rows = shadows_on && shadow_box.area() > 0;
-    for (int y = 0; y < H; ++y) {
-      const uchar* src = env8.ptr<uchar>(y);
-      float* dst = env_linear.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(W) * 3;
-      if (!shadow_rows || y < shadow_box.y || y >= shadow_box.y + shadow_box.height) {
-        if (first)
-          for (int i = 0; i < 3 * W; ++i) dst[i] = lut[src[i]];
-        else
-          for (int i = 0; i < 3 * W; ++i) dst[i] += lut[src[i]];
-        continue;
-      }
-      const uchar* s = shadow_mask.ptr<uchar>(y);
-      const uchar* r = receiver_mask.ptr<uchar>(y);
-      for (int x = 0; x < W; ++x) {
-        float f = 1.f;
-        if (s[x] != 0 && r[x] != 0)
-          f = 1.f - (1.f - keep) * (static_cast<float>(s[x]) / 255.f) * (static_cast<float>(r[x]) / 255.f);
-        for (int ch = 0; ch < 3; ++ch) {
-          const float v = f * lut[src[3 * x + ch]];
-          dst[3 * x + ch] = first ? v : dst[3 * x + ch] + v;
-        }
-      }
-    }
-  }
-
   // ---- frame --------------------------------------------------------------------------------
-
-  // Environment at one instant, added with `weight` to env_linear (first: assigned).
-  void environment_pass(const Eigen::Isometry3d& world_T_cam, const Eigen::Isometry3d& world_T_obj, bool first,
-                        float weight) {
-    const Eigen::Isometry3d cam_T_world = world_T_cam.inverse();
-    const bool shadows_on = opt.shadows && scene.shadows.enabled;
-    render_environment(cam_T_world, shadows_on);
-    cv::Rect shadow_box;
-    if (shadows_on) {
-      add_shadow(scene.object_mesh, world_T_obj, cam_T_world, shadow_box);
-      for (const auto& m : scene.scenery) add_shadow(m, Eigen::Isometry3d::Identity(), cam_T_world, shadow_box);
-      if (shadow_box.area() > 0) {
-        const int pad = static_cast<int>(std::ceil(3 * scene.shadows.softness_px)) + 1;
-        shadow_box = cv::Rect(shadow_box.x - pad, shadow_box.y - pad, shadow_box.width + 2 * pad, shadow_box.height + 2 * pad) &
-                     cv::Rect(0, 0, W, H);
-        if (scene.shadows.softness_px > 0) {
-          soften(shadow_mask, shadow_box, scene.shadows.softness_px);
-        }
-      }
-    }
-    environment_to_linear(shadows_on, shadow_box, first, weight);
-    if (shadows_on && shadow_box.area() > 0)
-      for (int y = shadow_box.y; y < shadow_box.y + shadow_box.height; ++y)
-        std::fill(shadow_mask.ptr<uchar>(y) + shadow_box.x, shadow_mask.ptr<uchar>(y) + shadow_box.x + shadow_box.width, uchar{0});
-  }
 
   // Objects at one sub-frame: their samples replace the environment, added to `corr` as
   // (sample - environment) * weight, so that the environment itself is drawn once per frame.
@@ -987,7 +708,7 @@ struct Renderer::Impl {
     out.create(camera.height_px(), camera.width_px(), CV_8UC3);
     const int n_sub = static_cast<int>(frame.sub_frames.size());
     if (n_sub == 0) {
-      const cv::Vec3b plain = env_plain8.back();
+      const cv::Vec3b plain = environment->plain_bgr8();
       out.setTo(cv::Scalar(plain[0], plain[1], plain[2]));
       return;
     }
@@ -998,11 +719,13 @@ struct Renderer::Impl {
     const auto subs = frame.sub_frames;
     const double motion = n_sub > 1 ? environment_motion_px(subs) : 0.0;
     const int n_env = std::clamp(1 + static_cast<int>(std::ceil(motion / kEnvStepPx)), 1, n_sub);
+    env_instants.resize(static_cast<std::size_t>(n_env));
     for (int j = 0; j < n_env; ++j) {
       const double f = n_env == 1 ? 0.5 : static_cast<double>(j) / (n_env - 1);
-      environment_pass(interpolate(subs, f, &SubFrame::world_T_cam), interpolate(subs, f, &SubFrame::world_T_obj),
-                       j == 0, 1.f / static_cast<float>(n_env));
+      env_instants[static_cast<std::size_t>(j)] = {interpolate(subs, f, &SubFrame::world_T_cam),
+                                                   interpolate(subs, f, &SubFrame::world_T_obj)};
     }
+    environment->render(env_instants, opt.shadows && scene.shadows.enabled, env_linear.data());
     corr_box = cv::Rect();
     for (int i = 0; i < n_sub; ++i)
       object_pass(subs[static_cast<std::size_t>(i)], i, n_sub, 1.f / static_cast<float>(n_sub));
