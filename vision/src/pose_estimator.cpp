@@ -63,10 +63,11 @@ double tukey_weight(double u, double c) {
   return t * t;
 }
 
-double tukey_rho(double r, double c) {
-  if (std::abs(r) >= c) return c * c / 6;
+// rho_max = c^2 / 6, hoisted out of the residual loops by the caller (the same value).
+double tukey_rho(double r, double c, double rho_max) {
+  if (std::abs(r) >= c) return rho_max;
   const double t = 1 - (r / c) * (r / c);
-  return c * c / 6 * (1 - t * t * t);
+  return rho_max * (1 - t * t * t);
 }
 
 double median_in_place(std::vector<double>& v) {
@@ -161,32 +162,35 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   bool visit_rejected = false;  // true while measuring every feature, rejected ones included
   auto skip = [&](int slot) { return !visit_rejected && rejected_[slot]; };
 
-  // Visits every residual (normalised by its sigma) with its Jacobian row and feature slot,
-  // skipping rejected features. With want_jacobian false, J is left untouched.
-  auto visit = [&](const Eigen::Isometry3d& pose, bool want_jacobian, auto&& fn) {
+  // Visits the line features: per line, its slot, the end points A, B in the camera, the image
+  // line l = A x B, s = |l_xy| and the line's undistorted edgels; skips rejected features.
+  auto visit_lines = [&](const Eigen::Isometry3d& pose, auto&& fn) {
     int slot = 0;
-    std::size_t list = 0;  // index into offsets_: lines, then ellipses
-    for (const auto& obs : problem.lines) {
-      const Eigen::Vector2d* xns = normalized_.data() + offsets_[list++];
-      if (obs.edgels_px.size() < 2 || skip(slot)) { ++slot; continue; }
+    for (std::size_t i = 0; i < problem.lines.size(); ++i, ++slot) {
+      const LineObservation& obs = problem.lines[i];
+      if (obs.edgels_px.size() < 2 || skip(slot)) continue;
       const Eigen::Vector3d A = pose * obs.a_obj, B = pose * obs.b_obj;
       const Eigen::Vector3d l = A.cross(B);
-      const double s = std::hypot(l.x(), l.y());
-      Eigen::Matrix<double, 3, 6> dl = Eigen::Matrix<double, 3, 6>::Zero();
-      if (want_jacobian) dl = -skew(B) * point_jacobian(A) + skew(A) * point_jacobian(B);
-      for (std::size_t k = 0; k < obs.edgels_px.size(); ++k) {
-        const Eigen::Vector3d x(xns[k].x(), xns[k].y(), 1);
-        const double ldx = l.dot(x);
-        const double r = focal * ldx / s / obs.sigma_px;
-        RowJ J;
-        if (want_jacobian) {
-          const Eigen::Vector3d dr_dl = (x / s - ldx / (s * s * s) * Eigen::Vector3d(l.x(), l.y(), 0)) * focal / obs.sigma_px;
-          J = dr_dl.transpose() * dl;
-        }
-        fn(r, J, slot);
-      }
-      ++slot;
+      fn(obs, slot, A, B, l, std::hypot(l.x(), l.y()), normalized_.data() + offsets_[i]);
     }
+  };
+  // The residual of an edgel x (undistorted, normalised) from the line l.
+  auto line_residual = [focal](const LineObservation& obs, const Eigen::Vector3d& l, double s, const Eigen::Vector2d& xn) {
+    return focal * l.dot(Eigen::Vector3d(xn.x(), xn.y(), 1)) / s / obs.sigma_px;
+  };
+  // Visits every residual (normalised by its sigma) with its feature slot, skipping rejected
+  // features. Jacobian rows (want_jacobian) are given for every feature but lines, whose normal
+  // equations normal_equations() accumulates per line; with want_jacobian false, J is untouched.
+  auto visit = [&](const Eigen::Isometry3d& pose, bool want_jacobian, auto&& fn) {
+    if (!want_jacobian) {
+      visit_lines(pose, [&](const LineObservation& obs, int slot, const Eigen::Vector3d&, const Eigen::Vector3d&,
+                            const Eigen::Vector3d& l, double s, const Eigen::Vector2d* xns) {
+        const RowJ J;
+        for (std::size_t k = 0; k < obs.edgels_px.size(); ++k) fn(line_residual(obs, l, s, xns[k]), J, slot);
+      });
+    }
+    int slot = static_cast<int>(problem.lines.size());
+    std::size_t list = problem.lines.size();  // index into offsets_: lines, then ellipses
     for (const auto& obs : problem.points) {
       if (skip(slot)) { ++slot; continue; }
       const Eigen::Vector3d X = pose * obs.p_obj;
@@ -237,6 +241,56 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
     }
   };
 
+  // Weighted normal equations H = sum w J^T J, g = sum w J^T r with Tukey weights at kernel
+  // width c, plus sum w r^2 and sum w. A line's residuals depend on the pose only through its
+  // image line l, so r_k = f(l, x_k) and J_k = (dr_k/dl)^T dl/dxi with one 3x6 dl/dxi per line:
+  // the edgels accumulate the 3x3 sum w (dr/dl)(dr/dl)^T and the 3-vector sum w r dr/dl, and
+  // the 6x6 is formed once per line (dl^T M dl) instead of once per edgel. The same sums,
+  // grouped differently (round-off only). `cost` is Tukey's cost at the pose, summed in the
+  // order of visit() (so equal to weighted_cost() below): the LM step test needs it anyway.
+  auto normal_equations = [&](const Eigen::Isometry3d& pose, double c, Matrix6d& H, Vector6d& g, double& wr2, double& wsum,
+                              double& cost) {
+    H.setZero();
+    g.setZero();
+    wr2 = 0;
+    wsum = 0;
+    cost = 0;
+    const double rho_max = c * c / 6;
+    visit_lines(pose, [&](const LineObservation& obs, int, const Eigen::Vector3d& A, const Eigen::Vector3d& B,
+                          const Eigen::Vector3d& l, double s, const Eigen::Vector2d* xns) {
+      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (std::size_t q = 0; q < obs.edgels_px.size(); ++q) {
+        const double r = line_residual(obs, l, s, xns[q]);
+        const double w = tukey_weight(r, c);  // no skip at w = 0: a non-finite row must still reach H
+        cost += tukey_rho(r, c, rho_max);
+        const Eigen::Vector3d x(xns[q].x(), xns[q].y(), 1);
+        const double ldx = l.dot(x);
+        // dr/dl, the same expression (and values) as the per-edgel Jacobian had.
+        const Eigen::Vector3d dr_dl = (x / s - ldx / (s * s * s) * Eigen::Vector3d(l.x(), l.y(), 0)) * focal / obs.sigma_px;
+        M.noalias() += (w * dr_dl) * dr_dl.transpose();
+        v += (w * r) * dr_dl;
+        wr2 += w * r * r;
+        wsum += w;
+      }
+      // dl/dxi of l = A x B under a left perturbation of the pose: dA = [I | -[A]x] dxi (same for
+      // B), so dl = [A - B]x dt - [l]x dphi (using [B]x[A]x - [A]x[B]x = [B x A]x).
+      Eigen::Matrix<double, 3, 6> dl;
+      dl.leftCols<3>() = skew(A - B);
+      dl.rightCols<3>() = -skew(l);
+      H.noalias() += dl.transpose() * M * dl;
+      g.noalias() += dl.transpose() * v;
+    });
+    visit(pose, true, [&](double r, const RowJ& J, int) {
+      const double w = tukey_weight(r, c);
+      H.noalias() += w * J.transpose() * J;
+      g.noalias() += w * J.transpose() * r;
+      wr2 += w * r * r;
+      wsum += w;
+      cost += tukey_rho(r, c, rho_max);
+    });
+  };
+
   auto all_in_front = [&](const Eigen::Isometry3d& pose) {
     for (const auto& obs : problem.lines) if ((pose * obs.a_obj).z() <= 0 || (pose * obs.b_obj).z() <= 0) return false;
     for (const auto& obs : problem.points) if ((pose * obs.p_obj).z() <= 0) return false;
@@ -278,27 +332,23 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   double lambda = 1e-3;
   for (int it = 0; it < options_.max_iterations; ++it) {
     out.iterations += 1;
-    H.setZero();
-    Vector6d g = Vector6d::Zero();
-    visit(pose, true, [&](double r, const RowJ& J, int) {
-      const double w = tukey_weight(r, c);
-      H.noalias() += w * J.transpose() * J;
-      g.noalias() += w * J.transpose() * r;
-    });
+    Vector6d g;
+    double unused_wr2 = 0, unused_wsum = 0, base = 0;
+    normal_equations(pose, c, H, g, unused_wr2, unused_wsum, base);
     if (!H.allFinite() || !g.allFinite()) {
       out.status = PoseStatus::Diverged;
       out.reason = "non-finite residuals or Jacobian";
       out.cam_T_obj = prior;
       return;
     }
-    // The cost with the weights of this iteration held fixed (IRLS inner problem).
-    // Tukey's robust cost at the scale of this iteration: a step is taken only if it lowers it.
+    // Tukey's robust cost at the scale of this iteration: a step is taken only if it lowers it
+    // below `base`, the cost at the current pose (summed by normal_equations above).
     auto weighted_cost = [&](const Eigen::Isometry3d& p) {
       double sum = 0;
-      visit(p, false, [&](double r, const RowJ&, int) { sum += tukey_rho(r, c); });
+      const double rho_max = c * c / 6;
+      visit(p, false, [&](double r, const RowJ&, int) { sum += tukey_rho(r, c, rho_max); });
       return sum;
     };
-    const double base = weighted_cost(pose);
     bool improved = false;
     Vector6d step = Vector6d::Zero();
     for (int tries = 0; tries < 8; ++tries) {
@@ -345,14 +395,9 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   // Final weights, degeneracy check, covariance and per-feature residuals at the solution.
   scale = std::max(options_.min_scale_px, robust_scale(pose));
   c = options_.tukey_c * scale;
-  H.setZero();
-  double wr2 = 0, wsum = 0;
-  visit(pose, true, [&](double r, const RowJ& J, int) {
-    const double w = tukey_weight(r, c);
-    H.noalias() += w * J.transpose() * J;
-    wr2 += w * r * r;
-    wsum += w;
-  });
+  double wr2 = 0, wsum = 0, unused_cost = 0;
+  Vector6d unused_g;
+  normal_equations(pose, c, H, unused_g, wr2, wsum, unused_cost);
   out.cam_T_obj = pose;
   out.scale_px = scale;
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(H);
