@@ -3,7 +3,8 @@
 //
 //   { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
 //     "init_pose": "teabox/init.csv",              // where tracking starts (cMo)
-//     "camera": { "device": "/dev/video0", "width": 640, "height": 480 },
+//     "camera": { "device": "/dev/video0", "width": 640, "height": 480,
+//                 "fps": 0 },                      // 0: the driver's current frame rate
 //     "can": { "interface": "can0" },
 //     "mode": "fixate",                            // fixate | stabilise | hold
 //     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
@@ -15,9 +16,11 @@
 #include <time.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -40,6 +43,54 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
+};
+
+// The SocketCAN driver stamps received frames with the kernel's wall clock (as candump does);
+// the onboard loop stamps the frames it sends with the program's monotonic clock. A log mixing
+// both spans 1.8e9 s and replays as nonsense (found by the VM test, docs/vm.md), so received
+// stamps are moved onto the monotonic clock here: the recorded log then has one time base, the
+// program's. The clocks' offset is measured once a second, so stamps of one stream keep their
+// order (a fresh, jittery offset per frame could reorder frames a millisecond apart), and a step
+// of the wall clock (NTP) is followed within a second.
+class MonotonicStampedBus final : public hw::CanBus {
+ public:
+  explicit MonotonicStampedBus(hw::CanBus& bus) : bus_(bus) {}
+  std::expected<void, std::string> send(const hw::CanFrame& frame) override { return bus_.send(frame); }
+  hw::CanReceive receive(hw::StampedCanFrame& out, double timeout_s) override {
+    const hw::CanReceive r = bus_.receive(out, timeout_s);
+    if (r == hw::CanReceive::Frame) out.stamp_us -= wall_minus_monotonic_us();
+    return r;
+  }
+  hw::CanBusStats stats() const override { return bus_.stats(); }
+  std::string_view last_error() const override { return bus_.last_error(); }
+
+ private:
+  static std::int64_t ns(const timespec& ts) { return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec; }
+  std::int64_t wall_minus_monotonic_us() {
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (measured_ && ns(now) - measured_at_ns_ < 1'000'000'000) return offset_us_;
+    // The wall clock read between two monotonic reads, against their midpoint; of three tries the
+    // tightest, so a preemption between the reads (a loaded machine, a VM) does not skew it.
+    std::int64_t best_width = std::numeric_limits<std::int64_t>::max(), offset_ns = 0;
+    for (int i = 0; i < 3; ++i) {
+      timespec before{}, wall{}, after{};
+      clock_gettime(CLOCK_MONOTONIC, &before);
+      clock_gettime(CLOCK_REALTIME, &wall);
+      clock_gettime(CLOCK_MONOTONIC, &after);
+      if (ns(after) - ns(before) < best_width) {
+        best_width = ns(after) - ns(before);
+        offset_ns = ns(wall) - (ns(before) + ns(after)) / 2;
+      }
+    }
+    measured_ = true;
+    measured_at_ns_ = ns(now);
+    offset_us_ = offset_ns / 1000;
+    return offset_us_;
+  }
+  hw::CanBus& bus_;
+  bool measured_ = false;
+  std::int64_t measured_at_ns_ = 0, offset_us_ = 0;
 };
 
 std::expected<RunConfig, std::string> read_config(const std::string& path) {
@@ -67,6 +118,7 @@ std::expected<RunConfig, std::string> read_config(const std::string& path) {
       c.camera.device = cam.value("device", c.camera.device);
       c.camera.width = cam.value("width", c.camera.width);
       c.camera.height = cam.value("height", c.camera.height);
+      c.camera.frame_rate_hz = cam.value("fps", c.camera.frame_rate_hz);
     }
     if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
   } catch (const nlohmann::json::exception& e) {
@@ -101,7 +153,8 @@ int run_onboard(const std::string& config_path, double seconds) {
   hw::MonotonicClock clock;
   head::OnboardPorts ports;
   ports.clock = &clock;
-  ports.bus = bus->get();
+  MonotonicStampedBus monotonic_bus(**bus);
+  ports.bus = &monotonic_bus;
   ports.camera = camera->get();
   ports.wait_until = [&clock](double t_s) -> std::expected<void, std::string> {
     // Absolute sleep on the monotonic clock: a late wake-up does not shift later ticks.
@@ -132,6 +185,12 @@ int run_onboard(const std::string& config_path, double seconds) {
               static_cast<unsigned long long>(summary->frames), static_cast<unsigned long long>(summary->tracked),
               static_cast<unsigned long long>(summary->lost), static_cast<unsigned long long>(summary->imu_samples),
               static_cast<unsigned long long>(summary->commands_sent));
+  const hw::CanBusStats bus_stats = (*bus)->stats();
+  std::printf("run: tracking %.1f ms median, tick work %.2f ms median; bus: %llu frames received, %llu dropped by the "
+              "kernel (receive queue full), %llu sends failed; camera: %llu frames dropped by the device\n",
+              summary->track_ms_median, summary->tick_ms_median, static_cast<unsigned long long>(bus_stats.rx_frames),
+              static_cast<unsigned long long>(bus_stats.rx_dropped), static_cast<unsigned long long>(bus_stats.tx_failed),
+              static_cast<unsigned long long>((*camera)->stats().dropped_frames));
   std::printf("run: wrote %s and %s\n", options.candump_path.c_str(), options.diagnostics_path.c_str());
   return 0;
 }

@@ -40,6 +40,9 @@ std::expected<std::unique_ptr<V4l2Camera>, std::string> V4l2Camera::open(const V
     return std::unexpected(camera->error_text("buffers must be 2 to 32", 0));
   }
   if (options.formats.empty()) return std::unexpected(camera->error_text("no pixel format requested", 0));
+  if (!(options.frame_rate_hz >= 0 && options.frame_rate_hz <= 10000)) {
+    return std::unexpected(camera->error_text("frame_rate_hz must be 0 (the driver's) to 10000", 0));
+  }
   if (auto opened = camera->open_device(); !opened) return std::unexpected(opened.error());
   return camera;
 }
@@ -66,6 +69,25 @@ std::expected<void, std::string> V4l2Camera::open_device() {
     release_device();
     return negotiated;
   }
+  if (auto rate = set_frame_rate(); !rate) {
+    release_device();
+    return rate;
+  }
+  return {};
+}
+
+std::expected<void, std::string> V4l2Camera::set_frame_rate() {
+  if (options_.frame_rate_hz <= 0) return {};
+  v4l2_streamparm p{};
+  p.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  if (sys_.ioctl(fd_, VIDIOC_G_PARM, &p) < 0 || !(p.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
+    return std::unexpected(error_text("the driver cannot set a frame rate (no V4L2_CAP_TIMEPERFRAME)", 0));
+  }
+  // A frame interval of 1000 / (rate * 1000) s keeps fractional rates (7.5 Hz) exact.
+  p.parm.capture.timeperframe.numerator = 1000;
+  p.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(std::lround(options_.frame_rate_hz * 1000));
+  if (sys_.ioctl(fd_, VIDIOC_S_PARM, &p) < 0) return std::unexpected(error_text("cannot set the frame rate (VIDIOC_S_PARM)", errno));
+  // The driver answers with the nearest interval it supports, and streams at that one.
   return {};
 }
 

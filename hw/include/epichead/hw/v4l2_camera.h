@@ -22,6 +22,7 @@ struct V4l2CameraOptions {
   std::string device = "/dev/video0";
   int width = 640, height = 480;        // requested; the driver may choose the nearest size
   std::vector<std::uint32_t> formats = {fourcc('G', 'R', 'E', 'Y'), fourcc('Y', 'U', 'Y', 'V')};  // by preference
+  double frame_rate_hz = 0;             // > 0: asked of the driver (VIDIOC_S_PARM); 0: its current rate
   int buffers = 4;                      // mmap buffers requested (the driver may give more)
   double reconnect_interval_s = 0.5;    // between reopen attempts after the device went away
 };
@@ -54,6 +55,7 @@ class V4l2Camera final : public CameraPort {
   V4l2Camera(const V4l2CameraOptions& options, Syscalls& sys, Clock& clock);
   std::expected<void, std::string> open_device();
   std::expected<void, std::string> negotiate_format();
+  std::expected<void, std::string> set_frame_rate();
   std::expected<void, std::string> start_streaming();
   void release_device();   // unmaps, closes; no ioctl (the device may be gone)
   CameraRead lose_device(int error);

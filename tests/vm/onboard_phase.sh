@@ -1,0 +1,54 @@
+# The onboard loop in the VM (run by init.sh, busybox sh): `epichead sim-peers` plays the IMU
+# and the pan/tilt head on vcan1 in real time, `epichead run` runs the onboard loop on the vivid
+# camera and that bus for RUN_S seconds, then `epichead replay` must read the candump log the
+# loop recorded without a malformed line, unknown frame, error frame or decode error, with the
+# IMU, head state and heartbeats in it. vivid shows test patterns, not the model, so the tracker
+# is lost: the loop, the bus traffic, the log and the replay are what is tested.
+run_s=${ONBOARD_RUN_S:-5}
+rc=0
+bad() { echo "onboard: FAILED: $*"; rc=1; }
+cd /tmp || exit 1
+
+epichead sim-peers --can vcan1 --seconds $((run_s + 2)) >/tmp/peers.log 2>&1 &
+peers=$!
+sleep 0.5   # the nodes are on the bus before the loop starts
+epichead run --config /etc/onboard/run.json --seconds "$run_s" >/tmp/run.log 2>&1 || bad "epichead run exited $?"
+cat /tmp/run.log
+wait $peers || bad "epichead sim-peers exited non-zero"
+cat /tmp/peers.log
+
+# "run: T ticks (L late), F frames (K tracked, X lost), I IMU samples, C commands"
+summary=$(grep '^run: [0-9]* ticks' /tmp/run.log)
+field() { echo "$summary" | sed -n "s/.* \([0-9][0-9]*\) $1.*/\1/p"; }
+frames=$(field 'frames'); imu=$(field 'IMU samples'); commands=$(field 'commands')
+[ -n "$frames" ] && [ "$frames" -gt 0 ] || bad "no camera frames reached the loop ($summary)"
+[ -n "$imu" ] && [ "$imu" -gt 0 ] || bad "no IMU samples reached the loop ($summary)"
+[ -n "$commands" ] && [ "$commands" -gt 0 ] || bad "the loop sent no head commands ($summary)"
+
+log=/tmp/run-out/bus.log
+[ -s "$log" ] || { bad "no candump log at $log"; exit 1; }
+echo "onboard: $(wc -l <"$log") lines in $log, first: $(head -1 "$log")"
+if ! epichead replay "$log" --json >/tmp/replay.json 2>/tmp/replay.err; then
+  cat /tmp/replay.err
+  bad "epichead replay failed"
+  exit 1
+fi
+# One jq expression per property, each printed with its verdict.
+check() {
+  if jq -e "$1" /tmp/replay.json >/dev/null; then echo "onboard: ok   $1"; else bad "replay: $1"; fi
+}
+check '.malformed_lines == 0'
+check '.timestamps == "all"'
+check '.duration_s > 0 and .duration_s < 60'   # one time base: sent and received frames on the same clock
+check '.error_frames == 0'
+check '.unknown_frames == 0'
+check '[.ids[] | .stamps_backwards // 0] | add == 0'
+check '[.messages[] | .decode_errors[]] | add // 0 | . == 0'
+check '.imu_samples > 0'
+check '.messages.HeadState.decoded > 0'
+check '.messages.HeadCommand.decoded > 0'
+check '.messages.TimeSyncReply.decoded > 0'
+check '.messages.Heartbeat.decoded > 0'
+jq -c '[.ids[] | select(.stamps_backwards) | {id, message, stamps_backwards}]' /tmp/replay.json
+jq -c '{frames, duration_s, bus_load, imu_samples, messages: (.messages | map_values({decoded, counter_lost}))}' /tmp/replay.json
+exit $rc
