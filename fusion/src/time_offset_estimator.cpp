@@ -22,6 +22,8 @@ std::expected<TimeOffsetEstimator, std::string> TimeOffsetEstimator::create(cons
   for (double v : values)
     if (!std::isfinite(v) || !(v > 0)) return std::unexpected("time offset estimator: ranges, step, window and rates must be positive");
   if (o.step_s > o.max_offset_s) return std::unexpected("time offset estimator: step_s larger than max_offset_s");
+  if (!(o.outlier_factor > 1) || !std::isfinite(o.outlier_factor))
+    return std::unexpected("time offset estimator: outlier_factor must be finite and above 1");
   if (o.min_pairs < 3) return std::unexpected("time offset estimator: min_pairs must be at least 3");
   if (!o.cam_R_imu.allFinite()) return std::unexpected("time offset estimator: cam_R_imu not finite");
   return TimeOffsetEstimator(o);
@@ -33,6 +35,8 @@ TimeOffsetEstimator::TimeOffsetEstimator(const TimeOffsetOptions& o) : options_(
   integral_.reserve(gyro_capacity);
   pairs_.reserve(static_cast<std::size_t>(o.window_s * 400) + 16);  // up to 400 poses/s
   costs_.reserve(static_cast<std::size_t>(2 * std::floor(o.max_offset_s / o.step_s) + 1));
+  use_.reserve(pairs_.capacity());
+  residuals_.reserve(pairs_.capacity());
 }
 
 void TimeOffsetEstimator::add_gyro(double t_imu_s, const Eigen::Vector3d& gyro_radps) {
@@ -91,27 +95,12 @@ bool TimeOffsetEstimator::usable(const Pair& p) const {
 double TimeOffsetEstimator::cost(double offset_s) const {
   double sum = 0;
   Eigen::Vector3d g;
-  for (const Pair& p : pairs_)
-    if (usable(p) && mean_rate(p.t0_s + offset_s, p.t1_s + offset_s, g)) sum += (p.rate - g).squaredNorm();
+  for (std::size_t i = 0; i < pairs_.size(); ++i)
+    if (use_[i] && mean_rate(pairs_[i].t0_s + offset_s, pairs_[i].t1_s + offset_s, g)) sum += (pairs_[i].rate - g).squaredNorm();
   return sum;
 }
 
-std::optional<TimeOffsetEstimate> TimeOffsetEstimator::fit() const {
-  int n = 0;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  double sq = 0;
-  for (const Pair& p : pairs_) {
-    if (!usable(p)) continue;
-    mean += p.rate;
-    sq += p.rate.squaredNorm();
-    ++n;
-  }
-  if (n < 3) return std::nullopt;
-  mean /= n;
-  double var = 0;
-  for (const Pair& p : pairs_)
-    if (usable(p)) var += (p.rate - mean).squaredNorm();
-
+double TimeOffsetEstimator::best_offset(double& best_cost, bool& at_edge) const {
   const int steps = static_cast<int>(std::floor(options_.max_offset_s / options_.step_s));
   costs_.resize(static_cast<std::size_t>(2 * steps + 1));  // within the capacity reserved at create()
   int best_k = -steps;
@@ -119,17 +108,68 @@ std::optional<TimeOffsetEstimate> TimeOffsetEstimator::fit() const {
     costs_[static_cast<std::size_t>(k + steps)] = cost(k * options_.step_s);
     if (costs_[static_cast<std::size_t>(k + steps)] < costs_[static_cast<std::size_t>(best_k + steps)]) best_k = k;
   }
+  at_edge = best_k == -steps || best_k == steps;
+  best_cost = costs_[static_cast<std::size_t>(best_k + steps)];
+  double offset = best_k * options_.step_s;
+  if (!at_edge) {
+    const double cm = costs_[static_cast<std::size_t>(best_k + steps - 1)], cp = costs_[static_cast<std::size_t>(best_k + steps + 1)];
+    const double curvature = cm - 2 * best_cost + cp;
+    if (curvature > 0) offset += 0.5 * (cm - cp) / curvature * options_.step_s;
+  }
+  return offset;
+}
+
+std::optional<TimeOffsetEstimate> TimeOffsetEstimator::fit() const {
+  use_.assign(pairs_.size(), 0);  // within the capacity reserved at create()
+  int usable_pairs = 0;
+  for (std::size_t i = 0; i < pairs_.size(); ++i) {
+    use_[i] = usable(pairs_[i]);
+    usable_pairs += use_[i];
+  }
+  if (usable_pairs < 3) return std::nullopt;
   TimeOffsetEstimate e;
+  double best = 0;
+  e.offset_s = best_offset(best, e.at_search_edge);
+
+  // Second pass without the outlier pairs: residual norms at the first fit against their median.
+  residuals_.clear();
+  Eigen::Vector3d g;
+  for (std::size_t i = 0; i < pairs_.size(); ++i)
+    if (use_[i] && mean_rate(pairs_[i].t0_s + e.offset_s, pairs_[i].t1_s + e.offset_s, g)) residuals_.push_back((pairs_[i].rate - g).norm());
+  if (residuals_.size() >= 3) {
+    const auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
+    std::nth_element(residuals_.begin(), mid, residuals_.end());
+    const double limit = options_.outlier_factor * *mid;
+    auto outlier = [&](std::size_t i) {
+      return !mean_rate(pairs_[i].t0_s + e.offset_s, pairs_[i].t1_s + e.offset_s, g) || (pairs_[i].rate - g).norm() > limit;
+    };
+    int outliers = 0;
+    for (std::size_t i = 0; i < pairs_.size(); ++i) outliers += use_[i] && outlier(i);
+    if (outliers > 0 && usable_pairs - outliers >= 3) {
+      for (std::size_t i = 0; i < pairs_.size(); ++i)
+        if (use_[i] && outlier(i)) use_[i] = 0;
+      e.outlier_pairs = outliers;
+      e.offset_s = best_offset(best, e.at_search_edge);
+    }
+  }
+
+  // Excitation and explained variation over the pairs of the final fit.
+  int n = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double sq = 0;
+  for (std::size_t i = 0; i < pairs_.size(); ++i) {
+    if (!use_[i]) continue;
+    mean += pairs_[i].rate;
+    sq += pairs_[i].rate.squaredNorm();
+    ++n;
+  }
+  if (n < 3) return std::nullopt;
+  mean /= n;
+  double var = 0;
+  for (std::size_t i = 0; i < pairs_.size(); ++i)
+    if (use_[i]) var += (pairs_[i].rate - mean).squaredNorm();
   e.pairs = n;
   e.rate_rms_radps = std::sqrt(sq / n);
-  e.at_search_edge = best_k == -steps || best_k == steps;
-  const double best = costs_[static_cast<std::size_t>(best_k + steps)];
-  e.offset_s = best_k * options_.step_s;
-  if (!e.at_search_edge) {
-    const double cm = costs_[static_cast<std::size_t>(best_k + steps - 1)], cp = costs_[static_cast<std::size_t>(best_k + steps + 1)];
-    const double curvature = cm - 2 * best + cp;
-    if (curvature > 0) e.offset_s += 0.5 * (cm - cp) / curvature * options_.step_s;
-  }
   e.explained = var > 0 ? 1.0 - best / var : 0.0;
   return e;
 }

@@ -4,7 +4,10 @@
 // interval, once the interval is moved onto the IMU clock (t_imu = t_camera + offset). The
 // estimate is the offset in [-max, +max] that minimises the summed squared difference over the
 // recent pose pairs (a grid search refined by a parabola through the best three points), with
-// how much of the camera's rate variation it explains as the confidence. Vectors, not rate
+// how much of the camera's rate variation it explains as the confidence. One wrong pose (a
+// frame tracked a few degrees off under blur) makes two pairs with rate errors of 100 deg/s,
+// which would dominate a plain squared sum: the fit is repeated without the pairs whose
+// residual at the first fit is far above the typical one (a median rule, no scene constant). Vectors, not rate
 // magnitudes, are compared, so a rotation about one axis cannot be matched by another.
 //
 // Why not a filter state: the offset is constant per rig and session, shows only while the
@@ -31,13 +34,17 @@ struct TimeOffsetOptions {
   int min_pairs = 45;             // 1.5 s of poses at 30 Hz
   double min_rate_rms_radps = 0.15;  // the camera must turn at least this much (RMS) to tell
   double min_explained = 0.6;       // fraction of the rate variation the fit must explain
+  // A pair is an outlier when its residual at the first fit exceeds this many times the median
+  // residual (3: about 4.4 sigma for a Rayleigh-like residual norm, so noise alone rarely trips it).
+  double outlier_factor = 3.0;
   Eigen::Matrix3d cam_R_imu = Eigen::Matrix3d::Identity();
 };
 
 struct TimeOffsetEstimate {
   double offset_s = 0;              // t_imu = t_camera + offset_s
   double explained = 0;             // 1 - residual / variation of the camera's rate
-  int pairs = 0;
+  int pairs = 0;                    // pairs used in the final fit
+  int outlier_pairs = 0;            // pairs left out as outliers
   double rate_rms_radps = 0;        // the camera's rate RMS over the pairs (excitation)
   bool at_search_edge = false;      // the best grid point was at +-max_offset_s
 };
@@ -66,13 +73,17 @@ class TimeOffsetEstimator {
     Eigen::Vector3d rate;     // camera axes, rad/s
   };
   bool usable(const Pair& p) const;
-  double cost(double offset_s) const;
+  double cost(double offset_s) const;  // over the pairs marked in use_
+  // Grid search and parabola over the pairs in use_: the best offset and its cost.
+  double best_offset(double& best_cost, bool& at_edge) const;
   TimeOffsetOptions options_;
   // Gyro samples and the running integral of the rate (camera axes) at each, oldest first.
   std::vector<double> t_;
   std::vector<Eigen::Vector3d> integral_;
   std::vector<Pair> pairs_;  // oldest first
   mutable std::vector<double> costs_;  // fit()'s grid, sized at create()
+  mutable std::vector<unsigned char> use_;  // fit()'s per-pair flag (usable, not an outlier)
+  mutable std::vector<double> residuals_;   // fit()'s scratch for the median, sized at create()
   bool have_pose_ = false;
   double last_pose_t_s_ = 0;
   Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity();
