@@ -186,6 +186,9 @@ TEST_CASE("reprojection error is the mean pixel distance of the projected model 
   // A point behind the camera in the poses is left out.
   CHECK(score_poses(gt, est, kCamera, points_model({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -3)}))
             .per_frame[0].reprojection_px == Approx(2.0));
+  // A point in front but outside the image at the true pose is left out too.
+  CHECK(score_poses(gt, est, kCamera, points_model({Eigen::Vector3d::Zero(), Eigen::Vector3d(5, 0, 0.01)}))
+            .per_frame[0].reprojection_px == Approx(2.0));
   // No usable point at all: NaN, and the statistics skip it.
   const ScoreSummary none = score_poses(gt, est, kCamera, points_model({Eigen::Vector3d(0, 0, -3)}));
   CHECK(std::isnan(none.per_frame[0].reprojection_px));

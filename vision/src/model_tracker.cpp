@@ -118,6 +118,12 @@ void ModelTracker::build_problem() {
     const LineFeature& f = features[e];
     const int chosen = validated ? validation_.selected[e] : f.selected;
     if (!f.visible || chosen < 0) continue;
+    // The piece seen, not the whole model edge: the same 3D line (so the same residuals), but
+    // the pose's "in front of the camera" test is then about what is seen. A room's wall edge
+    // runs behind the camera; with its far vertex behind, no step would ever pass that test
+    // and the pose stayed at the prediction (office_pan: the 1 cm / 1 deg start error for good).
+    obs.a_obj = f.piece.a_obj;
+    obs.b_obj = f.piece.b_obj;
     const LineCandidate& c = f.result.candidates[static_cast<std::size_t>(chosen)];
     const WindowGeometry& g = f.result.geometry;
     const int n = std::min(c.support, std::max(2, options_.max_edgels_per_line));

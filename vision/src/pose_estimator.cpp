@@ -291,8 +291,12 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
     });
   };
 
+  // The observed segments must stay in front of the camera. Only lines with edgels count: a
+  // caller may keep empty slots for every model edge, and an unseen edge may well run behind
+  // the camera (a room's wall edge), which would otherwise refuse every step.
   auto all_in_front = [&](const Eigen::Isometry3d& pose) {
-    for (const auto& obs : problem.lines) if ((pose * obs.a_obj).z() <= 0 || (pose * obs.b_obj).z() <= 0) return false;
+    for (const auto& obs : problem.lines)
+      if (obs.edgels_px.size() >= 2 && ((pose * obs.a_obj).z() <= 0 || (pose * obs.b_obj).z() <= 0)) return false;
     for (const auto& obs : problem.points) if ((pose * obs.p_obj).z() <= 0) return false;
     return true;
   };

@@ -46,8 +46,11 @@ std::vector<Eigen::Vector3d> reprojection_points(const CadModel& model) {
   return points;
 }
 
-// Mean pixel distance of the points projected with both poses; points behind the camera in
-// either pose are left out. NaN when no point is usable.
+// Mean pixel distance of the points projected with both poses, over the points the image
+// shows at the true pose: points behind the camera in either pose, or outside the image at the
+// true pose, are left out. A room's vertices may lie beside or just in front of the camera,
+// where the distortion polynomial (fitted inside the image) sends them to 1e12 px. NaN when no
+// point is usable.
 double reprojection_error_px(const std::vector<Eigen::Vector3d>& points, const Camera& camera,
                              const Eigen::Isometry3d& gt_T, const Eigen::Isometry3d& est_T) {
   double sum = 0;
@@ -55,7 +58,9 @@ double reprojection_error_px(const std::vector<Eigen::Vector3d>& points, const C
   for (const auto& p : points) {
     const Eigen::Vector3d a = gt_T * p, b = est_T * p;
     if (!(a.z() > 0) || !(b.z() > 0)) continue;
-    const double d = (camera.project(a) - camera.project(b)).norm();
+    const Eigen::Vector2d seen_px = camera.project(a);
+    if (!camera.in_image(seen_px)) continue;
+    const double d = (seen_px - camera.project(b)).norm();
     if (!std::isfinite(d)) continue;
     sum += d;
     ++n;
