@@ -16,7 +16,6 @@
 #include <time.h>
 
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +27,7 @@
 #include "command.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/hw/clock.h"
+#include "epichead/hw/monotonic_stamped_bus.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
 #include "epichead/vision/camera.h"
@@ -43,54 +43,6 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
-};
-
-// The SocketCAN driver stamps received frames with the kernel's wall clock (as candump does);
-// the onboard loop stamps the frames it sends with the program's monotonic clock. A log mixing
-// both spans 1.8e9 s and replays as nonsense (found by the VM test, docs/vm.md), so received
-// stamps are moved onto the monotonic clock here: the recorded log then has one time base, the
-// program's. The clocks' offset is measured once a second, so stamps of one stream keep their
-// order (a fresh, jittery offset per frame could reorder frames a millisecond apart), and a step
-// of the wall clock (NTP) is followed within a second.
-class MonotonicStampedBus final : public hw::CanBus {
- public:
-  explicit MonotonicStampedBus(hw::CanBus& bus) : bus_(bus) {}
-  std::expected<void, std::string> send(const hw::CanFrame& frame) override { return bus_.send(frame); }
-  hw::CanReceive receive(hw::StampedCanFrame& out, double timeout_s) override {
-    const hw::CanReceive r = bus_.receive(out, timeout_s);
-    if (r == hw::CanReceive::Frame) out.stamp_us -= wall_minus_monotonic_us();
-    return r;
-  }
-  hw::CanBusStats stats() const override { return bus_.stats(); }
-  std::string_view last_error() const override { return bus_.last_error(); }
-
- private:
-  static std::int64_t ns(const timespec& ts) { return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec; }
-  std::int64_t wall_minus_monotonic_us() {
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    if (measured_ && ns(now) - measured_at_ns_ < 1'000'000'000) return offset_us_;
-    // The wall clock read between two monotonic reads, against their midpoint; of three tries the
-    // tightest, so a preemption between the reads (a loaded machine, a VM) does not skew it.
-    std::int64_t best_width = std::numeric_limits<std::int64_t>::max(), offset_ns = 0;
-    for (int i = 0; i < 3; ++i) {
-      timespec before{}, wall{}, after{};
-      clock_gettime(CLOCK_MONOTONIC, &before);
-      clock_gettime(CLOCK_REALTIME, &wall);
-      clock_gettime(CLOCK_MONOTONIC, &after);
-      if (ns(after) - ns(before) < best_width) {
-        best_width = ns(after) - ns(before);
-        offset_ns = ns(wall) - (ns(before) + ns(after)) / 2;
-      }
-    }
-    measured_ = true;
-    measured_at_ns_ = ns(now);
-    offset_us_ = offset_ns / 1000;
-    return offset_us_;
-  }
-  hw::CanBus& bus_;
-  bool measured_ = false;
-  std::int64_t measured_at_ns_ = 0, offset_us_ = 0;
 };
 
 std::expected<RunConfig, std::string> read_config(const std::string& path) {
@@ -153,7 +105,8 @@ int run_onboard(const std::string& config_path, double seconds) {
   hw::MonotonicClock clock;
   head::OnboardPorts ports;
   ports.clock = &clock;
-  MonotonicStampedBus monotonic_bus(**bus);
+  // SocketCAN stamps with the wall clock, the loop runs on the monotonic one (monotonic_stamped_bus.h).
+  hw::MonotonicStampedBus monotonic_bus(**bus);
   ports.bus = &monotonic_bus;
   ports.camera = camera->get();
   ports.wait_until = [&clock](double t_s) -> std::expected<void, std::string> {
