@@ -6,6 +6,8 @@
 //     "camera": { "device": "/dev/video0", "width": 640, "height": 480,
 //                 "fps": 0 },                      // 0: the driver's current frame rate
 //     "can": { "interface": "can0" },
+//     "head": { "pan_backlash_rad": 0,             // the gear's dead band per joint, as measured
+//               "tilt_backlash_rad": 0 },          // (docs/head.md); 0: no compensation
 //     "mode": "fixate",                            // fixate | stabilise | hold
 //     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
 //
@@ -43,6 +45,7 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
+  head::JointBacklash backlash;
 };
 
 std::expected<RunConfig, std::string> read_config(const std::string& path) {
@@ -73,6 +76,11 @@ std::expected<RunConfig, std::string> read_config(const std::string& path) {
       c.camera.frame_rate_hz = cam.value("fps", c.camera.frame_rate_hz);
     }
     if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
+    if (j.contains("head")) {
+      const auto& h = j["head"];
+      c.backlash.pan_rad = h.value("pan_backlash_rad", c.backlash.pan_rad);
+      c.backlash.tilt_rad = h.value("tilt_backlash_rad", c.backlash.tilt_rad);
+    }
   } catch (const nlohmann::json::exception& e) {
     return std::unexpected(path + ": wrong type: " + e.what());
   }
@@ -124,6 +132,7 @@ int run_onboard(const std::string& config_path, double seconds) {
   };
   head::OnboardOptions options;
   options.mode = mode->second;
+  options.controller.backlash = config->backlash;
   options.candump_path = (fs::path(config->out) / "bus.log").string();
   options.candump_iface = config->can.interface;
   options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();

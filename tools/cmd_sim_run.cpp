@@ -67,6 +67,9 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
 
   head::OnboardOptions o;
   o.mode = mode;
+  // The head's gear backlash as the controller's calibration: the simulator knows the truth
+  // (scenario key head_backlash_rad, both joints); on the robot it comes from the configuration.
+  o.controller.backlash = {scenario.head_dynamics.backlash_rad, scenario.head_dynamics.backlash_rad};
   o.processing_s = a.processing_ms * 1e-3;
   if (render) {
     o.candump_path = (fs::path(out) / "bus.log").string();
@@ -202,6 +205,7 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                           {"accel_limited", s.controller.accel_limited},
                           {"position_limited", s.controller.position_limited},
                           {"encode_clipped", s.controller.encode_clipped},
+                          {"backlash_reversals", s.controller.backlash_reversals},
                           {"events", s.controller.events}}},
           {"imu_assembly", {{"samples", s.imu_assembly.samples},
                             {"unpaired", s.imu_assembly.unpaired},

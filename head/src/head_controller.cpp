@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace epichead::head {
 namespace {
@@ -104,6 +105,11 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
     return std::unexpected("head controller options: park.pan_rad outside the pan limits");
   if (!finite(o.park.tilt_rad) || o.park.tilt_rad < o.tilt.min_rad || o.park.tilt_rad > o.tilt.max_rad)
     return std::unexpected("head controller options: park.tilt_rad outside the tilt limits");
+  for (const auto& [v, name] : {std::pair{o.backlash.pan_rad, "backlash.pan_rad"},
+                                 std::pair{o.backlash.tilt_rad, "backlash.tilt_rad"}}) {
+    if (auto ok = non_negative(v, name); !ok) return std::unexpected(ok.error());
+    if (v > 0.5) return std::unexpected(std::string("head controller options: ") + name + " above 0.5 rad");
+  }
   if (o.safe_mode != ControlMode::Hold && o.safe_mode != ControlMode::Park)
     return std::unexpected("head controller options: safe_mode must be hold or park");
   if (!finite(o.mount.pan_origin_body) || !finite(o.mount.tilt_origin_pan) || !finite(o.mount.cam_offset_tilt) ||
@@ -114,7 +120,8 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
 
 HeadController::HeadController(const HeadControllerOptions& o)
     // The IMU may run faster than the loop: room for 2 kHz over the history.
-    : options_(o), watchdog_(o.watchdog), attitude_(o.history_s, std::max(o.rate_hz, 2000.0)), joint_rates_(o.joint_rates) {}
+    : options_(o), watchdog_(o.watchdog), attitude_(o.history_s, std::max(o.rate_hz, 2000.0)), joint_rates_(o.joint_rates),
+      pan_backlash_(o.backlash.pan_rad), tilt_backlash_(o.backlash.tilt_rad) {}
 
 void HeadController::emit(ControlOutput& out, const HeadEvent& e) {
   ++counters_.events;
@@ -200,6 +207,8 @@ void HeadController::enter(ControlMode mode, ModeReason reason, double t_s, Cont
                 clamp_rate(head_.pan_rate_radps, options_.pan)};
     tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
                  clamp_rate(head_.tilt_rate_radps, options_.tilt)};
+    pan_backlash_.reset(pan_cmd_.angle_rad);
+    tilt_backlash_.reset(tilt_cmd_.angle_rad);
   }
   blend_t0_s_ = t_s;
   blend_from_ = {pan_cmd_.rate_radps, tilt_cmd_.rate_radps};
@@ -358,6 +367,8 @@ ControlOutput HeadController::step(const ControlInput& in) {
                 clamp_rate(head_.pan_rate_radps, options_.pan)};
     tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
                  clamp_rate(head_.tilt_rate_radps, options_.tilt)};
+    pan_backlash_.reset(pan_cmd_.angle_rad);
+    tilt_backlash_.reset(tilt_cmd_.angle_rad);
   }
 
   const Resolved r = resolve();
@@ -382,17 +393,28 @@ ControlOutput HeadController::step(const ControlInput& in) {
     };
     bound(pan_cmd_, head_.angles.pan_rad);
     bound(tilt_cmd_, head_.angles.tilt_rad);
+    pan_backlash_.place(pan_cmd_.angle_rad);
+    tilt_backlash_.place(tilt_cmd_.angle_rad);
   }
 
   out.target_error_rad = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector2d rates = desired_rates(t, out);
+  Eigen::Vector2d output_rates = Eigen::Vector2d::Zero();
   if (mode_ != ControlMode::Startup) {
     if (options_.switch_blend_s > 0) {
       const double a = std::clamp((t - blend_t0_s_) / options_.switch_blend_s, 0.0, 1.0);
       rates = (1 - a) * blend_from_ + a * rates;
     }
+    // The camera-rate laws want output rates: through the dead-band inverse to motor rates. Hold
+    // and Park steer the joint angles the encoder measures; the band's model still follows.
+    if (mode_ == ControlMode::Stabilise || mode_ == ControlMode::Fixate) {
+      rates = {pan_backlash_.motor_rate(rates.x(), pan_cmd_, options_.pan, dt),
+               tilt_backlash_.motor_rate(rates.y(), tilt_cmd_, options_.tilt, dt)};
+    }
     pan_cmd_ = shape(options_.pan, pan_cmd_, rates.x(), dt, out.pan_limits);
     tilt_cmd_ = shape(options_.tilt, tilt_cmd_, rates.y(), dt, out.tilt_limits);
+    output_rates = {pan_backlash_.follow(pan_cmd_, dt), tilt_backlash_.follow(tilt_cmd_, dt)};
+    counters_.backlash_reversals = pan_backlash_.reversals() + tilt_backlash_.reversals();
     for (std::uint8_t hits : {out.pan_limits, out.tilt_limits}) {
       counters_.rate_limited += (hits & kLimitRate) != 0;
       counters_.accel_limited += (hits & kLimitAccel) != 0;
@@ -413,7 +435,14 @@ ControlOutput HeadController::step(const ControlInput& in) {
   c.tilt_rate_radps = wire_rate(tilt_cmd_.rate_radps, counters_.encode_clipped);
   c.counter = counter_;
   if (out.dispatch == Dispatch::Send) {
-    joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps});
+    if (pan_backlash_.active() || tilt_backlash_.active()) {
+      // A joint without backlash: its output moves with the motor, at the rate on the wire.
+      if (!pan_backlash_.active()) output_rates.x() = c.pan_rate_radps;
+      if (!tilt_backlash_.active()) output_rates.y() = c.tilt_rate_radps;
+      joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps}, output_rates);
+    } else {
+      joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps});
+    }
     counter_ = static_cast<std::uint8_t>((counter_ + 1) & 0x0f);
     ++counters_.sent;
   } else {

@@ -5,19 +5,22 @@
 
 namespace epichead::head {
 
-void JointRateEstimate::sent(double t_s, const Eigen::Vector2d& rates_radps) {
+void JointRateEstimate::sent(double t_s, const Eigen::Vector2d& rates_radps, const Eigen::Vector2d& output_rates_radps) {
   const double act_t_s = t_s + options_.command_delay_s;
-  // Where the modelled joint rate stands when this command starts to act.
-  Eigen::Vector2d model = rates_radps;
+  // Where the modelled joint rates stand when this command starts to act.
+  Eigen::Vector2d model = rates_radps, output_model = output_rates_radps;
   if (count_ > 0) {
     const Sent& prev = sent_[newest_];
     if (act_t_s < prev.t_s) return;
-    if (options_.motor_lag_s > 0) model = model_at(prev, act_t_s);
+    if (options_.motor_lag_s > 0) {
+      model = model_at(prev, act_t_s);
+      output_model = output_model_at(prev, act_t_s);
+    }
   } else if (options_.motor_lag_s > 0) {
-    model = measured_;  // the first command starts from the joints' measured motion
+    model = output_model = measured_;  // the first command starts from the joints' measured motion
   }
   newest_ = count_ == 0 ? 0 : (newest_ + 1) % kCapacity;
-  sent_[newest_] = {act_t_s, rates_radps, model};
+  sent_[newest_] = {act_t_s, rates_radps, model, output_rates_radps, output_model};
   count_ = std::min(count_ + 1, kCapacity);
 }
 
@@ -29,10 +32,11 @@ const JointRateEstimate::Sent* JointRateEstimate::in_force(double t_s) const {
   return nullptr;
 }
 
-Eigen::Vector2d JointRateEstimate::model_at(const Sent& s, double t_s) const {
-  if (!(options_.motor_lag_s > 0)) return s.command_radps;
-  const double decay = std::exp(-std::max(0.0, t_s - s.t_s) / options_.motor_lag_s);
-  return s.command_radps + decay * (s.model_radps - s.command_radps);
+Eigen::Vector2d JointRateEstimate::lagged(const Eigen::Vector2d& command, const Eigen::Vector2d& model, double from_t_s,
+                                          double t_s) const {
+  if (!(options_.motor_lag_s > 0)) return command;
+  const double decay = std::exp(-std::max(0.0, t_s - from_t_s) / options_.motor_lag_s);
+  return command + decay * (model - command);
 }
 
 void JointRateEstimate::measured(double t_s, const Eigen::Vector2d& rates_radps) {
@@ -49,7 +53,7 @@ void JointRateEstimate::measured(double t_s, const Eigen::Vector2d& rates_radps)
 }
 
 Eigen::Vector2d JointRateEstimate::at(double t_s) const {
-  if (const Sent* s = in_force(t_s)) return model_at(*s, t_s) + correction_;
+  if (const Sent* s = in_force(t_s)) return output_model_at(*s, t_s) + correction_;
   return measured_;
 }
 

@@ -1,5 +1,6 @@
 #include "head_sim_helpers.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -42,14 +43,14 @@ Eigen::Vector3d body_rate_radps(const std::vector<BodyBurst>& bursts, double t_s
 }
 
 HeadPlant::HeadPlant(const HeadMount& mount, const PlantOptions& options, std::vector<BodyBurst> bursts, JointAngles start)
-    : mount_(mount), options_(options), bursts_(std::move(bursts)), q_(start), rng_(options.seed) {}
+    : mount_(mount), options_(options), bursts_(std::move(bursts)), q_(start), q_out_(start), rng_(options.seed) {}
 
 void HeadPlant::send(double t_s, const firmware_iface::HeadCommand& command) {
   pending_.push_back({t_s + options_.command_latency_s, command});
 }
 
 Eigen::Quaterniond HeadPlant::world_R_cam() const {
-  return world_R_body_ * Eigen::Quaterniond(body_T_cam(mount_, q_).linear());
+  return world_R_body_ * Eigen::Quaterniond(body_T_cam(mount_, q_out_).linear());
 }
 
 void HeadPlant::advance_to(double t_s) {
@@ -70,9 +71,20 @@ void HeadPlant::advance_to(double t_s) {
     if (stuck_pan_) qd_.x() = 0;
     q_.pan_rad += qd_.x() * h;
     q_.tilt_rad += qd_.y() * h;
-    const Eigen::Matrix<double, 3, 2> J = joint_axes_cam(mount_, q_);
-    const Eigen::Matrix3d cam_R_body = body_T_cam(mount_, q_).linear().transpose();
-    camera_rate_ = cam_R_body * w_body + J * qd_;
+    if (options_.backlash_rad > 0) {
+      // The output rests inside the dead band and is pushed at either edge.
+      const double half = 0.5 * options_.backlash_rad;
+      const JointAngles before = q_out_;
+      q_out_.pan_rad = std::clamp(q_out_.pan_rad, q_.pan_rad - half, q_.pan_rad + half);
+      q_out_.tilt_rad = std::clamp(q_out_.tilt_rad, q_.tilt_rad - half, q_.tilt_rad + half);
+      qd_out_ = Eigen::Vector2d(q_out_.pan_rad - before.pan_rad, q_out_.tilt_rad - before.tilt_rad) / h;
+    } else {
+      q_out_ = q_;
+      qd_out_ = qd_;
+    }
+    const Eigen::Matrix<double, 3, 2> J = joint_axes_cam(mount_, q_out_);
+    const Eigen::Matrix3d cam_R_body = body_T_cam(mount_, q_out_).linear().transpose();
+    camera_rate_ = cam_R_body * w_body + J * qd_out_;
     const Eigen::Vector3d phi = w_body * h;
     world_R_body_ = (world_R_body_ * Eigen::Quaterniond(Eigen::AngleAxisd(phi.norm(), phi.norm() > 0 ? phi.normalized() : Eigen::Vector3d::UnitX()))).normalized();
     t_s_ += h;

@@ -1,8 +1,10 @@
 #pragma once
 // A small body + head simulation for the head tests: a walking-robot-like body (angular-rate
 // bursts at every step, as sim/trajectory.h draws them), pan/tilt joints with a first-order
-// motor lag, a rate limit, an optional stuck joint and command latency, and the camera-mounted
-// gyro. The controller runs at 1 kHz; the plant integrates at 10 kHz.
+// motor lag, a rate limit, an optional stuck joint and command latency, optional gear backlash
+// (the output shaft, which carries the camera, rests inside a dead band until the motor pushes
+// it at either edge, as sim/sim_head_node.cpp does; the head state shows the motor), and the
+// camera-mounted gyro. The controller runs at 1 kHz; the plant integrates at 10 kHz.
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -31,6 +33,7 @@ struct PlantOptions {
   double position_gain_per_s = 50;  // the head's position loop: rate ref = cmd rate + k (cmd angle - angle)
   double motor_rate_max_radps = 8;
   double command_latency_s = 0.0005;
+  double backlash_rad = 0;          // gear dead band between motor (encoder) and output (camera), per joint
   double gyro_noise_radps = 0;      // white, per sample (1 kHz)
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   std::uint64_t seed = 7;
@@ -46,12 +49,13 @@ class HeadPlant {
   void send(double t_s, const firmware_iface::HeadCommand& command);
 
   GyroReading gyro(double t_s);               // the gyro now (camera axes, with noise and bias)
-  JointState head_state(double t_s) const;    // quantised like the wire
+  JointState head_state(double t_s) const;    // the motor side (encoder), quantised like the wire
   Eigen::Vector3d true_camera_rate() const { return camera_rate_; }
   Eigen::Quaterniond world_R_cam() const;
   const Eigen::Quaterniond& world_R_body() const { return world_R_body_; }
-  JointAngles angles() const { return q_; }
-  Eigen::Vector2d joint_rates() const { return qd_; }
+  JointAngles angles() const { return q_out_; }       // output side: where the camera points
+  JointAngles motor_angles() const { return q_; }     // motor side: what the encoder measures
+  Eigen::Vector2d joint_rates() const { return qd_out_; }
   void set_stuck_pan(bool stuck) { stuck_pan_ = stuck; }
 
  private:
@@ -60,8 +64,10 @@ class HeadPlant {
   std::vector<BodyBurst> bursts_;
   double t_s_ = 0;
   Eigen::Quaterniond world_R_body_ = Eigen::Quaterniond::Identity();
-  JointAngles q_;
+  JointAngles q_;                                      // motor
   Eigen::Vector2d qd_ = Eigen::Vector2d::Zero();
+  JointAngles q_out_;                                  // output (camera); q_ without backlash
+  Eigen::Vector2d qd_out_ = Eigen::Vector2d::Zero();
   Eigen::Vector3d camera_rate_ = Eigen::Vector3d::Zero();
   struct Pending { double apply_t_s; firmware_iface::HeadCommand command; };
   std::deque<Pending> pending_;

@@ -81,3 +81,16 @@ TEST_CASE("joint rates: with a motor lag the estimate follows a commanded step a
     CHECK(e.at(t).y() == Approx(-2.0 * f).margin(1e-9));
   }
 }
+
+TEST_CASE("joint rates: with backlash the estimate is the output side's, the correction compares the motor side",
+          "[head][joint_rates]") {
+  JointRateEstimate e(options());
+  // The motor crosses a dead band at 0.3 rad/s while the output rests.
+  for (int i = 0; i <= 100; ++i) {
+    e.sent(1.0 + i * 0.001, {0.3, -0.2}, {0.0, -0.2});
+    // The encoder measures the motor: the motor-side model agrees, nothing to correct.
+    if (i % 5 == 0) e.measured(1.0 + i * 0.001 + 0.0025, {0.3, -0.2});
+  }
+  CHECK(e.correction().norm() < 1e-12);
+  CHECK(e.at(1.05).isApprox(Eigen::Vector2d(0.0, -0.2)));
+}

@@ -17,6 +17,10 @@
 // to the park angles at the park rate. Every switch blends the commanded rate linearly from its
 // value at the switch to the new mode's over switch_blend_s, and every command passes the
 // limit shaper (joint_limits.h), so no command exceeds a position, rate or acceleration limit.
+// With the head's gear backlash calibrated (options.backlash), Stabilise and Fixate command the
+// motors through its inverse (backlash_compensation.h): the camera-rate laws want output-shaft
+// rates, the motor crosses the dead band quickly after a reversal, and the joint rates taken
+// off the gyro are the output's.
 //
 // Watchdog (watchdog.h): ImuStale -> Stabilise/Fixate fall back to Hold; BusOff or
 // HeadStateStale -> safe_mode (Hold or Park) and, while bus-off, Dispatch::Withhold; TargetLost
@@ -33,6 +37,7 @@
 
 #include "epichead/firmware_iface/head_command.h"
 #include "epichead/firmware_iface/head_state.h"
+#include "epichead/head/backlash_compensation.h"
 #include "epichead/head/control_mode.h"
 #include "epichead/head/gyro_attitude.h"
 #include "epichead/head/head_kinematics.h"
@@ -48,6 +53,9 @@ struct HeadControllerOptions {
   HeadMount mount;
   JointLimits pan = default_pan_limits();
   JointLimits tilt = default_tilt_limits();
+  // The gear's dead band between motor (encoder) and output (camera) per joint, as measured on
+  // the head (docs/head.md); 0 = no compensation. Used in Stabilise and Fixate.
+  JointBacklash backlash;
   double rate_hz = 1000;                  // nominal control rate: a longer tick is integrated as at most 5 nominal ticks
   double stabilise_gain_per_s = 60;       // optical-axis angle error -> camera rate (1/s)
   double fixate_gain_per_s = 5;           // target angle error -> camera rate (1/s)
@@ -131,6 +139,7 @@ struct HeadCounters {
   std::uint64_t target_rejected = 0;        // non-finite, behind the camera, or no attitude at its time
   std::uint64_t rate_limited = 0, accel_limited = 0, braking_limited = 0, position_limited = 0;  // joint-ticks
   std::uint64_t following_error_clamped = 0;  // joint-ticks the commanded angle was pulled toward the measured one
+  std::uint64_t backlash_reversals = 0;     // dead-band crossings started by the compensation (both joints)
   std::uint64_t encode_clipped = 0;         // command values beyond the wire's range (clipped)
   std::uint64_t events = 0, events_dropped = 0;
 };
@@ -194,6 +203,7 @@ class HeadController {
   bool attitude_broken_ = false;          // an IMU gap since the last target: directions do not compare
 
   JointCommand pan_cmd_, tilt_cmd_;       // the last command (internal, continuous angle)
+  BacklashCompensator pan_backlash_, tilt_backlash_;  // where each output sits in its dead band
   Eigen::Vector3d reference_dir_ = Eigen::Vector3d::UnitZ();  // Stabilise: optical axis to hold (inertial)
   JointAngles hold_;                      // Hold target
   bool parked_reported_ = false;
