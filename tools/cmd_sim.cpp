@@ -31,7 +31,7 @@ const CommandRegistration registration{
           ->required();
       CLI::Option* frames_opt = app.add_option("--frames", *frames, "Number of frames (overrides the scenario)")->check(CLI::Range(1, 1000000));
       CLI::Option* seed_opt = app.add_option("--seed", *seed, "Random seed (overrides the scenario); output is identical for a seed");
-      CLI::Option* jerk_opt = app.add_option("--jerk", *jerk, "Scale of the walking robot's angular-rate bursts and bob (walking motion only)")
+      CLI::Option* jerk_opt = app.add_option("--jerk", *jerk, "Scale of the body's jerks: the walking robot's angular-rate bursts and bob, or the hand-held camera's shakes")
           ->check(CLI::Range(0.0, 20.0));
       app.footer("Built-in scenarios: " + builtin_list() + ". Format of .scn files: sim/scenarios/README.md.");
       return [=]() -> int {
@@ -40,9 +40,9 @@ const CommandRegistration registration{
         if (frames_opt->count() > 0) s->frames = *frames;
         if (seed_opt->count() > 0) s->seed = *seed;
         if (jerk_opt->count() > 0) {
-          if (s->motion != sim::MotionKind::walking)
-            return fail("sim", "--jerk applies to walking motion only; scenario '" + s->name + "' is not walking");
-          s->walking.jerk = *jerk;
+          if (s->motion == sim::MotionKind::walking) s->walking.jerk = *jerk;
+          else if (s->motion == sim::MotionKind::handheld) s->handheld.jerk = *jerk;
+          else return fail("sim", "--jerk applies to walking and hand-held motion; scenario '" + s->name + "' is wheeled");
         }
         const bool tty = isatty(STDERR_FILENO) != 0;
         auto progress = [tty](int i, int n) {

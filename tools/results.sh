@@ -40,22 +40,27 @@ mkdir -p "$out"
 rows="$out/rows.md"
 : > "$rows"
 
+# fmt FILE JQ_EXPR PRINTF_FORMAT: a number from a JSON file, or "–" when it is null (a tracker
+# that lost every frame has no error statistics).
+fmt() {
+  local v
+  v=$(jq -r "$2" "$1")
+  if [[ "$v" == null || -z "$v" ]]; then printf '–'; else printf "$3" "$v"; fi
+}
+
 # row SEQ_LABEL TRACKER IMU OUT_DIR SCORE_JSON
 row() {
   local label="$1" tracker="$2" imu="$3" dir="$4" score="$5"
-  local ms
-  ms=$(jq -r '.track_ms_median' "$dir/report.json")
+  local common
+  common="$(fmt "$score" '.success_rate * 100' '%.1f %%') | $(fmt "$score" '.rotation_deg.median' '%.2f') | $(fmt "$score" '.translation_mm.median' '%.1f')"
   if jq -e '.corners' "$score" >/dev/null 2>&1 && [[ "$(jq -r '.against' "$score")" != "gt.csv" ]]; then
     # Real video: agreement with the peer's poses and hand-read corners.
-    printf '| %s | %s | %s | %.1f %% | %.2f | %.1f | %s | %.2f |\n' "$label" "$tracker" "$imu" \
-      "$(jq -r '.success_rate * 100' "$score")" "$(jq -r '.rotation_deg.median' "$score")" \
-      "$(jq -r '.translation_mm.median' "$score")" \
-      "$(jq -r '[.corners[] | if .present then (.rms_px * 10 | round / 10 | tostring) else "lost" end] | join(" / ")' "$score") px" \
-      "$ms" >> "$rows"
+    printf '| %s | %s | %s | %s | %s px | %s |\n' "$label" "$tracker" "$imu" "$common" \
+      "$(jq -r '[.corners[] | if .present then (.rms_px * 10 | round / 10 | tostring) else "lost" end] | join(" / ")' "$score")" \
+      "$(fmt "$dir/report.json" '.track_ms_median' '%.2f')" >> "$rows"
   else
-    printf '| %s | %s | %s | %.1f %% | %.2f | %.1f | %d losses | %.2f |\n' "$label" "$tracker" "$imu" \
-      "$(jq -r '.success_rate * 100' "$score")" "$(jq -r '.rotation_deg.median' "$score")" \
-      "$(jq -r '.translation_mm.median' "$score")" "$(jq -r '.losses' "$score")" "$ms" >> "$rows"
+    printf '| %s | %s | %s | %s | %s losses | %s |\n' "$label" "$tracker" "$imu" "$common" \
+      "$(jq -r '.losses' "$score")" "$(fmt "$dir/report.json" '.track_ms_median' '%.2f')" >> "$rows"
   fi
 }
 

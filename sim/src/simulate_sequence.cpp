@@ -133,7 +133,7 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const s
   j << "{\n  \"scenario\": \"" << s.name << "\",\n  \"scene\": \"" << s.scene << "\",\n  \"seed\": " << s.seed
     << ",\n  \"frames\": " << s.frames << ",\n  \"fps\": " << num(s.fps) << ",\n  \"first_frame_s\": "
     << num(s.frame_time_s(0)) << ",\n  \"exposure_s\": " << num(exposure_s) << ",\n  \"blur_subframes\": " << subframes
-    << ",\n  \"jerk\": " << num(s.walking.jerk) << ",\n  \"peak_body_rate_degps\": " << num(summary.peak_body_rate_degps)
+    << ",\n  \"jerk\": " << num(s.motion == MotionKind::handheld ? s.handheld.jerk : s.walking.jerk) << ",\n  \"peak_body_rate_degps\": " << num(summary.peak_body_rate_degps)
     << ",\n  \"head_deg\": [" << num(head0.pan_rad * rad2deg) << ", " << num(head0.tilt_rad * rad2deg) << "]"
     << ",\n  \"imu\": {\n    \"time\": \"t_device_s = clock_offset_s + (1 + clock_drift) * t_true_s\",\n"
     << "    \"clock_offset_s\": " << num(s.imu.clock_offset_s) << ",\n    \"clock_drift\": " << num(s.imu.clock_drift)

@@ -117,6 +117,7 @@ Trajectory Trajectory::handheld(const HandheldParams& p) {
   t.kind_ = Kind::handheld;
   t.hand_ = p;
   t.bursts_ = p.shakes;
+  for (Burst& b : t.bursts_) b.peak_rate_radps *= p.jerk;
   std::sort(t.bursts_.begin(), t.bursts_.end(), [](const Burst& a, const Burst& b) { return a.t0_s < b.t0_s; });
   Random rng(p.seed, 12);
   // Incommensurate frequencies and random phases: the sway never repeats within a sequence.

@@ -98,6 +98,19 @@ TEST_CASE("jerk scales the walking robot's bursts and dip", "[sim][trajectory]")
   CHECK(more.at(t_dip).pose.translation().z() == Approx(2.5 * one.at(t_dip).pose.translation().z()));
 }
 
+TEST_CASE("jerk scales the hand-held camera's shakes, not its sway", "[sim][trajectory]") {
+  HandheldParams p;
+  p.sway_deg = 0;  // no sway: the peak rate is the shake's alone
+  p.shakes.push_back({1.0, 0.3, Eigen::Vector3d::UnitZ(), 100 * deg});
+  const Trajectory one = Trajectory::handheld(p);
+  p.jerk = 2.0;
+  const Trajectory more = Trajectory::handheld(p);
+  CHECK(peak_angular_rate_degps(one, 0, 3, 1e-4) == Approx(100).epsilon(2e-3));
+  CHECK(peak_angular_rate_degps(more, 0, 3, 1e-4) == Approx(200).epsilon(2e-3));
+  // Before the shake the two are the same motion.
+  CHECK(one.at(0.5).pose.isApprox(more.at(0.5).pose, 1e-12));
+}
+
 TEST_CASE("wheeled robot drives its distance smoothly and turns with the given peak rate", "[sim][trajectory]") {
   WheeledParams p;
   p.start_world = {3, 0.5, 0};

@@ -146,9 +146,9 @@ TEST_CASE("sim rejects bad input with one line naming the reason", "[tools][sim]
   one_line(r);
   CHECK(r.err.find("no_such_scenario") != std::string::npos);
 
-  r = run("lampshade --out '" + out.string() + "' --jerk 2");
+  r = run("office_pan --out '" + out.string() + "' --jerk 2");
   one_line(r);
-  CHECK(r.err.find("walking") != std::string::npos);
+  CHECK(r.err.find("wheeled") != std::string::npos);
 
   const fs::path scn = scratch() / "broken.scn";
   std::ofstream(scn) << "scene box_clutter\nframes 3\nmotion handheld\nsway_hz lots\n";

@@ -73,14 +73,16 @@ struct WheeledParams {
 };
 
 // Hand-held camera: smooth sway (sums of sines with seeded phases and frequencies) about a
-// viewpoint, plus optional quick shakes.
+// viewpoint, plus optional quick shakes. `jerk` scales the shakes' peak rates (the sweep of
+// trackable speed, tools/jerk_sweep.sh); the sway stays as it is.
 struct HandheldParams {
   Eigen::Vector3d start_world{0.8, 0.0, 0.3};
   double heading_rad = 3.14159265358979;
   double sway_m = 0.03;      // position amplitude per axis
   double sway_deg = 3.0;     // angle amplitude per axis
   double sway_hz = 0.3;      // base frequency
-  std::vector<Burst> shakes; // added quick rotations
+  std::vector<Burst> shakes; // added quick rotations (peak rates at jerk 1)
+  double jerk = 1.0;
   std::uint64_t seed = 1;
 };
 
