@@ -9,6 +9,16 @@
 namespace epichead::tools {
 namespace {
 
+// 1-sigma of the camera-IMU time offset while it is unknown (--imu-time-offset-s auto, before the
+// estimate is adopted): a recorded imu.csv on its own device clock, as USB or CAN IMUs stamp and
+// the simulator writes, is typically some 5-25 ms off the camera's. Measured on the jerk sweep's
+// mockup_walk and box_clutter runs (docs/fusion.md): 0 lets a 14 ms offset gate good poses until
+// the filter drifts off (mockup_walk at jerk 0.5: 8 % success), 10 ms tracks all four test runs
+// best, and 33 ms weighs the poses so little that the filter drifts instead.
+constexpr double kUnknownOffsetSigmaS = 0.01;
+// After the estimate is adopted: its accuracy (within 1 ms in tests/fusion/test_time_offset_estimator.cpp).
+constexpr double kEstimatedOffsetSigmaS = 0.001;
+
 // Constant velocity in SE(3): the last relative motion between good poses, scaled to the
 // elapsed time and applied on the left (where camera motion acts on cam_T_obj).
 class ConstantVelocityPredictor final : public TrackPredictor {
@@ -152,6 +162,7 @@ class ImuPredictor final : public TrackPredictor {
     offset_s_ = e.offset_s;
     fusion::PredictorOptions o = options_;
     o.imu_time_offset_s = offset_s_;
+    o.imu_time_offset_sigma_s = kEstimatedOffsetSigmaS;
     auto p = fusion::Predictor::create(o);
     if (!p) return;  // options were valid once; only the offset changed
     predictor_ = std::move(*p);
@@ -192,6 +203,8 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
     options.imu_time_offset_s = imu_time_offset_s.value_or(0.0);
+    // Until the offset is estimated, every pose's time on the IMU clock is that uncertain.
+    if (!imu_time_offset_s) options.imu_time_offset_sigma_s = kUnknownOffsetSigmaS;
     auto predictor = fusion::Predictor::create(options);
     if (!predictor) return std::unexpected("--imu on: " + predictor.error());
     std::optional<fusion::TimeOffsetEstimator> estimator;

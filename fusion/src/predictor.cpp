@@ -36,6 +36,8 @@ std::expected<void, std::string> check(const PredictorOptions& o) {
     return bad("imu_noise", "must be finite and >= 0");
   if (!is_rotation(o.mount.cam_R_imu)) return bad("mount.cam_R_imu", "is not a rotation matrix");
   if (!finite(o.imu_time_offset_s)) return bad("imu_time_offset_s", "is not finite");
+  if (!finite(o.imu_time_offset_sigma_s) || o.imu_time_offset_sigma_s < 0 || o.imu_time_offset_sigma_s > 1)
+    return bad("imu_time_offset_sigma_s", "must be in [0, 1] s");
   if (!positive(o.imu_rate_hz) || o.imu_rate_hz > 1e5) return bad("imu_rate_hz", "must be in (0, 1e5]");
   if (!positive(o.buffer_s) || o.buffer_s > 10) return bad("buffer_s", "must be in (0, 10]");
   if (!(o.gyro_range_radps > 0) || !(o.accel_range_mps2 > 0)) return bad("gyro/accel range", "must be > 0");
@@ -323,6 +325,20 @@ VisionResult Predictor::add_vision_cv(double t_s, const Eigen::Isometry3d& cam_T
   return {VisionVerdict::Applied, r.mahalanobis2};
 }
 
+Matrix6d Predictor::with_timing_uncertainty(double t_s, const Entry& at_t, const Matrix6d& cov) const {
+  const double sigma_s = options_.imu_time_offset_sigma_s;
+  if (!(sigma_s > 0)) return cov;
+  // The pose's rate as a left perturbation (the vision covariance's convention), from the filter
+  // a few milliseconds on: the IMU's own propagation, so rotation and translation both count.
+  constexpr double kStepS = 0.005;
+  Entry ahead;
+  double extrapolated_s = 0;
+  if (!state_at(t_s + kStepS, ahead, extrapolated_s)) return cov;
+  const Vector6d rate = se3_log(ahead.x.cam_T_obj() * at_t.x.cam_T_obj().inverse()) / kStepS;
+  if (!rate.allFinite()) return cov;
+  return cov + (sigma_s * sigma_s) * rate * rate.transpose();
+}
+
 VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov_in) {
   PredictorCounters& c = status_.counters;
   const bool far_ahead = options_.mode == PredictorMode::ImuAided && count_ > 0 &&
@@ -346,7 +362,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     ++c.vision_too_old;
     return {VisionVerdict::TooOld, 0};
   }
-  const PoseUpdateResult r = update_pose(at_t.x, at_t.P, cam_T_obj, cov, options_.gate_chi2);
+  const PoseUpdateResult r = update_pose(at_t.x, at_t.P, cam_T_obj, with_timing_uncertainty(t_s, at_t, cov), options_.gate_chi2);
   if (!r.applied) {
     ++c.vision_gated;
     if (++status_.gated_in_a_row >= options_.reinit_after_gated) reinit_pending_ = true;

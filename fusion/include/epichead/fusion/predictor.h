@@ -30,6 +30,11 @@ struct PredictorOptions {
   ImuNoise imu_noise;
   ImuMount mount;                       // cam_R_imu
   double imu_time_offset_s = 0;         // t_camera = t_imu - offset
+  // 1-sigma of imu_time_offset_s. A vision pose's time on the IMU clock is then uncertain by this
+  // much, so its covariance grows by the pose's own motion over that time (rate x sigma): while
+  // the camera turns fast, a pose from a clock that may be 20 ms off is no better than ~1 deg,
+  // however sharp the image. 0: the offset is exact.
+  double imu_time_offset_sigma_s = 0;
   double imu_rate_hz = 1000;            // nominal; sizes the ring
   double buffer_s = 0.5;                // how late a vision pose may be
   double gyro_range_radps = 1e300;      // a reading at or beyond +-range on any axis is saturated
@@ -132,6 +137,8 @@ class Predictor {
     NavState x;
     ErrorCovariance P;
   };
+  // cov plus the pose's motion over the time offset's uncertainty (imu_time_offset_sigma_s).
+  Matrix6d with_timing_uncertainty(double t_s, const Entry& at_t, const Matrix6d& cov) const;
   // The state right after the last vision pose, at its exposure time (between two samples).
   // Its sample is the reading at that time (interpolated between neighbours, or held).
   struct Anchor {
