@@ -66,7 +66,7 @@ class ImuPredictor final : public TrackPredictor {
   ImuPredictor(const fusion::PredictorOptions& options, fusion::Predictor predictor, const vision::Sequence& seq,
                std::optional<fusion::TimeOffsetEstimator> estimator)
       : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
-        estimator_(std::move(estimator)), last_good_(seq.init().cam_T_obj) {
+        last_good_(seq.init().cam_T_obj), estimator_(std::move(estimator)) {
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
     init_t_s_ = seq.init().t_s;

@@ -1,5 +1,7 @@
 #include "head_sim_helpers.h"
 
+#include <catch2/catch.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -14,6 +16,15 @@ const double kShapePeak = std::pow(std::sqrt(3.0) / 2.0, 3) * 0.5;
 double quantise(double v, double lsb) { return std::nearbyint(v / lsb) * lsb; }
 
 }  // namespace
+
+void require_within_position_and_rate_limits(const firmware_iface::HeadCommand& command, const HeadControllerOptions& o) {
+  REQUIRE(command.pan_rad >= o.pan.min_rad);
+  REQUIRE(command.pan_rad <= o.pan.max_rad);
+  REQUIRE(command.tilt_rad >= o.tilt.min_rad);
+  REQUIRE(command.tilt_rad <= o.tilt.max_rad);
+  REQUIRE(std::abs(command.pan_rate_radps) <= o.pan.rate_max_radps + 1e-12);
+  REQUIRE(std::abs(command.tilt_rate_radps) <= o.tilt.rate_max_radps + 1e-12);
+}
 
 std::vector<BodyBurst> walking_bursts(double duration_s, std::uint64_t seed, double jerk) {
   std::mt19937_64 rng(seed);

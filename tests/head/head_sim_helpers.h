@@ -118,6 +118,10 @@ class ClosedLoop {
   std::mt19937_64 rng_{99};
 };
 
+// REQUIREs a command's joint angles within the position limits and its rates within the rate
+// limits of the controller's options (the checks every limits test starts with).
+void require_within_position_and_rate_limits(const firmware_iface::HeadCommand& command, const HeadControllerOptions& o);
+
 // The camera's x/y (image-shifting) and total angular-rate RMS of a run.
 struct RateRms {
   double xy_radps = 0, all_radps = 0;

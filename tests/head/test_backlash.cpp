@@ -208,12 +208,7 @@ TEST_CASE("with compensation on, closed-loop commands never exceed the rate, acc
     const ControlOutput& out = loop.tick();
     if (out.mode == ControlMode::Startup) continue;
     const auto& c = out.command;
-    REQUIRE(c.pan_rad >= o.pan.min_rad);
-    REQUIRE(c.pan_rad <= o.pan.max_rad);
-    REQUIRE(c.tilt_rad >= o.tilt.min_rad);
-    REQUIRE(c.tilt_rad <= o.tilt.max_rad);
-    REQUIRE(std::abs(c.pan_rate_radps) <= o.pan.rate_max_radps + 1e-12);
-    REQUIRE(std::abs(c.tilt_rate_radps) <= o.tilt.rate_max_radps + 1e-12);
+    require_within_position_and_rate_limits(c, o);
     if (have_prev) {
       REQUIRE(std::abs(c.pan_rate_radps - prev.pan_rate_radps) <= o.pan.accel_max_radps2 * 1e-3 + 1e-9);
       REQUIRE(std::abs(c.tilt_rate_radps - prev.tilt_rate_radps) <= o.tilt.accel_max_radps2 * 1e-3 + 1e-9);

@@ -10,8 +10,10 @@
 #include "epichead/firmware_iface/head_command.h"
 #include "epichead/head/head_controller.h"
 #include "epichead/head/joint_limits.h"
+#include "head_sim_helpers.h"
 
 using namespace epichead::head;
+using epichead::head::testing::require_within_position_and_rate_limits;
 using epichead::hw::CanBusState;
 
 namespace {
@@ -76,12 +78,7 @@ TEST_CASE("no command exceeds a position, rate or acceleration limit under rando
     const ControlOutput out = c.step(in);
     const auto& cmd = out.command;
     // Position, rate, grid, encodable.
-    REQUIRE(cmd.pan_rad >= o.pan.min_rad);
-    REQUIRE(cmd.pan_rad <= o.pan.max_rad);
-    REQUIRE(cmd.tilt_rad >= o.tilt.min_rad);
-    REQUIRE(cmd.tilt_rad <= o.tilt.max_rad);
-    REQUIRE(std::abs(cmd.pan_rate_radps) <= o.pan.rate_max_radps + 1e-12);
-    REQUIRE(std::abs(cmd.tilt_rate_radps) <= o.tilt.rate_max_radps + 1e-12);
+    require_within_position_and_rate_limits(cmd, o);
     REQUIRE(on_grid(cmd.pan_rate_radps, epichead::firmware_iface::kHeadRateRadpsPerLsb));
     REQUIRE(on_grid(cmd.pan_rad, epichead::firmware_iface::kHeadAngleRadPerLsb));
     REQUIRE(epichead::firmware_iface::encode(cmd).has_value());

@@ -69,9 +69,15 @@ std::int64_t now_ns(clockid_t clock) {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+// The vcan interface to test on; when there is none, reports it (device_absent) and the caller
+// returns.
 std::optional<std::string> vcan_interface() {
   const std::string name = env_or("EPICHEAD_TEST_VCAN", "vcan0");
-  if (!fs::exists("/sys/class/net/" + name)) return std::nullopt;
+  if (!fs::exists("/sys/class/net/" + name)) {
+    device_absent("vcan", "no vcan interface " + name + " (modprobe vcan; ip link add " + name + " type vcan; ip link set " +
+                              name + " up): not run");
+    return std::nullopt;
+  }
   return name;
 }
 
@@ -175,10 +181,7 @@ bool uhid_write(int fd, const uhid_event& event) {
 TEST_CASE("vcan: frames pass between two buses with kernel stamps, filters and no loss or reordering",
           "[hw][device][socketcan]") {
   const auto name = vcan_interface();
-  if (!name) {
-    device_absent("vcan", "no vcan interface (modprobe vcan; ip link add vcan0 type vcan; ip link set vcan0 up): not run");
-    return;
-  }
+  if (!name) return;
   SocketCanOptions all;
   all.interface = *name;
   SocketCanOptions only_0x123 = all;
@@ -234,10 +237,7 @@ TEST_CASE("vcan: frames pass between two buses with kernel stamps, filters and n
 TEST_CASE("vcan: frames the kernel drops for a full receive queue are counted, the rest stay in order",
           "[hw][device][socketcan]") {
   const auto name = vcan_interface();
-  if (!name) {
-    device_absent("vcan", "no vcan interface: not run");
-    return;
-  }
+  if (!name) return;
   SocketCanOptions options;
   options.interface = *name;
   auto sender = SocketCanBus::open(options);
@@ -270,10 +270,7 @@ TEST_CASE("vcan: frames the kernel drops for a full receive queue are counted, t
 
 TEST_CASE("vcan: an error frame on the bus reaches the driver and sets bus-off", "[hw][device][socketcan]") {
   const auto name = vcan_interface();
-  if (!name) {
-    device_absent("vcan", "no vcan interface: not run");
-    return;
-  }
+  if (!name) return;
   SocketCanOptions options;
   options.interface = *name;
   auto bus = SocketCanBus::open(options);

@@ -80,13 +80,12 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
       estimator_(camera, options.pose) {
   const std::size_t edges = model.edges.size();
   // One pose-problem slot per model edge, kept for the tracker's life: a slot's edgel buffer
-  // keeps its capacity, and unused slots (no edgels) are ignored by the estimator.
+  // keeps its capacity, and unused slots (no edgels) are ignored by the estimator. A slot's
+  // segment is set each frame from the piece seen (build_problem).
   problem_.lines.resize(edges);
   for (std::size_t e = 0; e < edges; ++e) {
     LineObservation& obs = problem_.lines[e];
     obs.feature = static_cast<int>(e);
-    obs.a_obj = model.vertices[static_cast<std::size_t>(model.edges[e].v0)];
-    obs.b_obj = model.vertices[static_cast<std::size_t>(model.edges[e].v1)];
     obs.edgels_px.reserve(static_cast<std::size_t>(options.lines.window.max_rows) * 4);
   }
   problem_.points.reserve(model.vertices.size());
