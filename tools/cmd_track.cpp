@@ -38,6 +38,7 @@ struct TrackArgs {
   int max_frames = 0;
   bool video = true;
   double crease_deg = 20.0;
+  double max_view_deg = 85.0;
   std::string imu_time_offset = "auto";
 };
 
@@ -149,6 +150,7 @@ int run_track(const TrackArgs& args) {
   ModelTrackerOptions options;
   options.mode = mode->second;
   options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
+  options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
   ModelTracker tracker(seq->model(), seq->camera(), options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
@@ -302,6 +304,9 @@ const CommandRegistration registration{
           ->expected(4)
           ->check(CLI::NonNegativeNumber);
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
+      app.add_option("--max-view-deg", a->max_view_deg,
+                     "Faces seen more edge-on than this (angle of normal to line of sight) count as turned away (default 85; 90: all front faces)")
+          ->check(CLI::Range(0.0, 90.0));
       return [a]() { return run_track(*a); };
     }};
 

@@ -156,7 +156,11 @@ TEST_CASE("object side of every contour edge is where the object is in the image
     const Eigen::Vector3d eye = Eigen::Vector3d(0.05, 0.05, 0.05) +
                                 0.5 * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     const auto pose = camera_at(eye, {0.05, 0.05, 0.05});
-    for (const auto& e : compute_visibility(cube, camera, pose).edges) {
+    // Geometric truth: every front face counts (the default hands a face seen nearly edge-on
+    // to the background side on purpose, see the next test).
+    VisibilityOptions all_front;
+    all_front.max_view_angle_rad = M_PI / 2;
+    for (const auto& e : compute_visibility(cube, camera, pose, all_front).edges) {
       const Eigen::Vector2d mid = 0.5 * (e.a_px + e.b_px);
       const Eigen::Vector2d d = (e.b_px - e.a_px).normalized();
       const Eigen::Vector2d left(d.y(), -d.x());
@@ -217,6 +221,40 @@ TEST_CASE("an L-shape edge behind the other arm is clipped to its visible pieces
   CHECK(pieces >= 1);
   CHECK(visible_fraction == Approx(0.43).margin(0.03));
   check_against_ray_caster(l, camera, pose);
+}
+
+TEST_CASE("a face seen nearly edge-on gives up its far edge, and its near edge becomes a contour", "[visibility]") {
+  // The camera faces the cube's y = 0 face and sees its x = 0.1 face at about 88 deg.
+  const CadModel cube = make_cube();
+  const Camera camera = test_camera();
+  const auto pose = camera_at({0.12, -0.5, 0.35}, {0.05, 0.05, 0.05});
+  auto on_right_face = [](const VisibleEdge& e) { return e.a_obj.x() > 0.099 && e.b_obj.x() > 0.099; };
+  auto far_vertical = [&](const VisibleEdge& e) { return on_right_face(e) && e.a_obj.y() > 0.099 && e.b_obj.y() > 0.099; };
+
+  VisibilityOptions all_front;
+  all_front.max_view_angle_rad = M_PI / 2;
+  const VisibleModel strict = compute_visibility(cube, camera, pose, all_front);
+  int far = 0, right_creases = 0, right_strict = 0;
+  for (const auto& e : strict.edges) {
+    far += far_vertical(e);
+    right_strict += on_right_face(e);
+    right_creases += on_right_face(e) && e.kind == EdgeKind::Crease;
+  }
+  CHECK(right_strict == 4);   // 90 deg: all four edges of the sliver: its far vertical and
+  CHECK(far == 1);            // bottom edges (contours) ...
+  CHECK(right_creases == 2);  // ... and its near edges (creases with the front and top faces)
+
+  const VisibleModel out = compute_visibility(cube, camera, pose);  // default 85 deg
+  int right = 0;
+  for (const auto& e : out.edges) {
+    CHECK_FALSE(far_vertical(e));
+    if (!on_right_face(e)) continue;
+    ++right;
+    CHECK(e.kind == EdgeKind::Contour);
+    CHECK(e.side != ObjectSide::Both);
+  }
+  CHECK(right == 2);  // the front and top edges of the sliver
+  CHECK(out.edges.size() + 2 == strict.edges.size());
 }
 
 TEST_CASE("edges between nearly coplanar facets are dropped unless on the silhouette", "[visibility]") {

@@ -66,6 +66,13 @@ Visibility::Visibility(const CadModel& model, const Camera& camera, const Visibi
   tri_x0_.resize(n); tri_x1_.resize(n); tri_y0_.resize(n); tri_y1_.resize(n);
   candidates_.reserve(n);
   face_front_.resize(model.faces.size());
+  face_seen_.resize(model.faces.size());
+  face_centroid_obj_.resize(model.faces.size(), Eigen::Vector3d::Zero());
+  for (std::size_t f = 0; f < model.faces.size(); ++f) {
+    const auto& face = model.faces[f];
+    for (int v : face.vertices) face_centroid_obj_[f] += model.vertices[v];
+    if (!face.vertices.empty()) face_centroid_obj_[f] /= static_cast<double>(face.vertices.size());
+  }
   hidden_.reserve(64);
 
   // The image frustum as the rectangle inscribed in the unprojected (undistorted) image border,
@@ -90,10 +97,14 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
   const Eigen::Vector3d t = cam_T_obj.translation();
   const Eigen::Vector3d camera_obj = -R.transpose() * t;
   const double near = options_.near_m;
+  const double cos_max_view = std::max(0.0, std::cos(options_.max_view_angle_rad));
 
   for (std::size_t f = 0; f < model.faces.size(); ++f) {
     const auto& face = model.faces[f];
-    face_front_[f] = face.normal_obj.dot(camera_obj) - face.offset_m > 0;
+    const double height_m = face.normal_obj.dot(camera_obj) - face.offset_m;
+    face_front_[f] = height_m > 0;
+    // cos(view angle) = height / distance, tested without the division.
+    face_seen_[f] = height_m > cos_max_view * (camera_obj - face_centroid_obj_[f]).norm();
   }
   for (std::size_t i = 0; i < model.vertices.size(); ++i) vertices_cam_[i] = R * model.vertices[i] + t;
 
@@ -223,14 +234,19 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
       kind = EdgeKind::Boundary;
       side_face = fa >= 0 ? 0 : 1;
     } else {
-      const bool front_a = face_front_[fa], front_b = face_front_[fb];
+      // Facets of a smooth surface keep the strict front test: their silhouette is where the
+      // surface turns away, however grazing the last facet. Across a sharp edge a face seen
+      // nearly edge-on counts as turned away (VisibilityOptions::max_view_angle_rad).
+      const bool smooth = model.faces[fa].normal_obj.dot(model.faces[fb].normal_obj) > cos_crease;
+      const bool front_a = smooth ? face_front_[fa] : face_seen_[fa];
+      const bool front_b = smooth ? face_front_[fb] : face_seen_[fb];
       if (front_a != front_b) {
         kind = EdgeKind::Contour;
         side_face = front_a ? 0 : 1;
       } else {
         // Both toward the camera, or both away on an open model (thin sheets seen from behind).
         if (!front_a && model.closed) continue;
-        if (model.faces[fa].normal_obj.dot(model.faces[fb].normal_obj) > cos_crease) continue;
+        if (smooth) continue;
         kind = EdgeKind::Crease;
       }
     }
