@@ -47,6 +47,7 @@ class ConstantVelocityPredictor final : public TrackPredictor {
     last_ = report.cam_T_obj;
     last_t_s_ = t_s;
   }
+  std::optional<Eigen::Isometry3d> fused(double) override { return std::nullopt; }
   nlohmann::json diagnostics() const override { return {{"model", "constant_velocity"}, {"lost_frames", lost_}}; }
 
  private:
@@ -104,6 +105,11 @@ class ImuPredictor final : public TrackPredictor {
     }
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
     if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld) pending_init_ = false;
+  }
+  std::optional<Eigen::Isometry3d> fused(double t_s) override {
+    if (pending_init_) return std::nullopt;  // the filter has no state yet
+    if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
+    return std::nullopt;
   }
   nlohmann::json diagnostics() const override {
     const auto st = predictor_.status(last_good_t_s_);

@@ -22,6 +22,10 @@ class TrackPredictor {
   virtual Eigen::Isometry3d predict(double t_s) = 0;
   // The tracker's result for the frame exposed at t_s.
   virtual void observe(double t_s, const vision::FrameReport& report) = 0;
+  // After observe(t_s): the fused estimate at t_s (the filter's posterior: the vision pose
+  // weighed against the IMU's propagation, or the propagation alone when the pose was gated
+  // out), or nothing when the predictor only extrapolates the vision poses.
+  virtual std::optional<Eigen::Isometry3d> fused(double t_s) = 0;
   // Counters for report.json.
   virtual nlohmann::json diagnostics() const = 0;
 };

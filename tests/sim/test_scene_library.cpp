@@ -93,7 +93,9 @@ TEST_CASE("every built-in scene is in view from its suggested viewpoint and rend
       inside += pc.z() > 0 && cam.in_image(cam.project(pc));
     }
     CHECK(inside >= static_cast<int>(scene->model.vertices.size()) / 2);
-    CHECK(visible_edges(*scene) >= 8);
+    // At least two faces' worth of edges (a box seen on two faces shows 7; a third face seen
+    // nearly edge-on counts as turned away, VisibilityOptions::max_view_angle_rad).
+    CHECK(visible_edges(*scene) >= 7);
     sim::RenderOptions o;
     o.samples_per_subframe = 2;
     sim::Renderer r(*scene, cam, o);

@@ -73,6 +73,32 @@ TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the track
   CHECK(fr["predictor"]["imu_time_offset_estimate"].is_null());
 }
 
+TEST_CASE("track --imu on writes the filter's estimate, which rides out the poses of blurred shakes") {
+  // box_clutter at twice its jerk: a 170 deg/s shake at 1.2 s blurs the box, and a pose from its
+  // few lines can be degrees off; the filter weighs it against the gyro.
+  TempDir tmp("epichead_test_track_fused");
+  const std::string seq = tmp / "box_clutter", out = tmp / "track";
+  REQUIRE(run_epichead(tmp, "sim box_clutter --out " + q(seq) + " --frames 75 --jerk 2").exit_code == 0);
+  const auto truth = nlohmann::json::parse(slurp(seq + "/sim_truth.json"));
+  const std::string offset = std::to_string(truth["imu"]["clock_offset_s"].get<double>());
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --imu on --imu-time-offset-s " + offset +
+                                         " --every 0 --no-video");
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  CHECK(report["fused_frames"].get<int>() == 75 - report["lost"].get<int>());
+  auto score = [&](const std::string& poses) {
+    const auto r = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/" + poses) + " --json");
+    REQUIRE(r.exit_code == 0);
+    return nlohmann::json::parse(r.out);
+  };
+  const auto fused = score("poses.csv"), vision = score("vision_poses.csv");
+  INFO("fused " << fused.dump() << "\nvision " << vision.dump());
+  CHECK(fused["success_rate"].get<double>() == 1.0);
+  CHECK(fused["success_rate"].get<double>() >= vision["success_rate"].get<double>());
+  CHECK(fused["rotation_deg"]["p95"].get<double>() < 0.75 * vision["rotation_deg"]["p95"].get<double>());
+}
+
 TEST_CASE("track follows the real teabox video to within a few pixels of the hand-read corners") {
   TempDir tmp("epichead_test_track_tool");
   const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox", out = tmp / "teabox";

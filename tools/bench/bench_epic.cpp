@@ -2,11 +2,14 @@
 // sampling + edgels + interval cues + likelihoods + RANSAC candidates + reference update.
 // ns per window pixel = median_us * 1000 / 1600.
 #include <memory>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "bench/bench.h"
+#include "epichead/vision/cues.h"
+#include "epichead/vision/edgels.h"
 #include "epichead/vision/epic.h"
 #include "epichead/vision/line_window.h"
 #include "epichead/vision/window_image.h"
@@ -63,6 +66,39 @@ const Registration epic_window{"epic_window", [] {
   return [s] { s->run(); };
 }};
 
+// The sampling step alone (the bilinear warp into the four cue planes), to split epic_window.
+const Registration epic_window_sample{"epic_window_sample", [] {
+  auto s = std::make_shared<State>(EpicMode::Epic);
+  return [s] { s->window.sample(s->image, s->a, s->b); };
+}};
+// Sampling + edgels, and sampling + edgels + the interval cues: the steps of epic_window in turn.
+const Registration epic_window_edgels{"epic_window_edgels", [] {
+  auto s = std::make_shared<State>(EpicMode::Epic);
+  return [s] {
+    s->window.sample(s->image, s->a, s->b);
+    find_edgels(s->window, EdgelOptions{}, s->result.edgels);
+  };
+}};
+const Registration epic_window_cues{"epic_window_cues", [] {
+  struct Cues {
+    State state{EpicMode::Epic};
+    CueHistograms histograms{CueOptions{}};
+    std::vector<IntervalCues> intervals;
+  };
+  auto s = std::make_shared<Cues>();
+  s->intervals.reserve(4096);
+  return [s] {
+    State& st = s->state;
+    st.window.sample(st.image, st.a, st.b);
+    find_edgels(st.window, EdgelOptions{}, st.result.edgels);
+    s->histograms.prepare(st.window);
+    s->histograms.intervals(st.window, st.result.edgels, s->intervals, true, false);  // ObjectSide::Left
+  };
+}};
+const Registration epic_window_single{"epic_window_single", [] {
+  auto s = std::make_shared<State>(EpicMode::EpicSingle);
+  return [s] { s->run(); };
+}};
 const Registration epic_window_gradient{"epic_window_gradient", [] {
   auto s = std::make_shared<State>(EpicMode::Gradient);
   return [s] { s->run(); };
