@@ -90,8 +90,7 @@ class Visibility {
   std::vector<float> tri_x0_, tri_x1_, tri_y0_, tri_y1_;
   std::vector<int> candidates_;  // scratch: triangles whose box meets the edge's
   std::vector<unsigned char> face_front_;  // the camera is on the face's outer side
-  std::vector<unsigned char> face_seen_;   // ... and sees it within max_view_angle_rad
-  std::vector<Eigen::Vector3d> face_centroid_obj_;
+  std::vector<double> face_height_m_;      // the camera's signed distance from the face's plane
   std::vector<std::pair<double, double>> hidden_;  // scratch intervals
   double xn_min_ = 0, xn_max_ = 0, yn_min_ = 0, yn_max_ = 0;  // image bounds, normalised
 };
