@@ -104,11 +104,14 @@ class ImuPredictor final : public TrackPredictor {
       }
     }
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
-    if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld) pending_init_ = false;
+    // A tracked pose supersedes the init pose as the filter's seed, whether it started the
+    // filter or could not yet (no IMU sample before it, or too old).
+    if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld ||
+        r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied)
+      pending_init_ = false;
   }
   std::optional<Eigen::Isometry3d> fused(double t_s) override {
-    if (pending_init_) return std::nullopt;  // the filter has no state yet
-    if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
+    if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;  // nothing before the filter starts
     return std::nullopt;
   }
   nlohmann::json diagnostics() const override {

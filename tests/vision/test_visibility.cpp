@@ -4,6 +4,7 @@
 // a hair of a piece's end.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -157,21 +158,33 @@ TEST_CASE("object side of every contour edge is where the object is in the image
                                 0.5 * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     const auto pose = camera_at(eye, {0.05, 0.05, 0.05});
     // Geometric truth: every front face counts (the default hands a face seen nearly edge-on
-    // to the background side on purpose, see the next test).
+    // to the background side on purpose, see the next test); on views with no face within
+    // 84-90 deg the default must agree as well.
     VisibilityOptions all_front;
     all_front.max_view_angle_rad = M_PI / 2;
-    for (const auto& e : compute_visibility(cube, camera, pose, all_front).edges) {
-      const Eigen::Vector2d mid = 0.5 * (e.a_px + e.b_px);
-      const Eigen::Vector2d d = (e.b_px - e.a_px).normalized();
-      const Eigen::Vector2d left(d.y(), -d.x());
-      // Just beside the edge: a face seen nearly edge-on may be under a pixel wide.
-      const bool on_left = pixel_on_object(cube, camera, pose, mid + 0.25 * left);
-      const bool on_right = pixel_on_object(cube, camera, pose, mid - 0.25 * left);
-      INFO("trial " << trial << " edge " << e.edge);
-      switch (e.side) {
-        case ObjectSide::Left: CHECK(on_left); CHECK_FALSE(on_right); break;
-        case ObjectSide::Right: CHECK(on_right); CHECK_FALSE(on_left); break;
-        case ObjectSide::Both: CHECK(on_left); CHECK(on_right); CHECK(e.kind == EdgeKind::Crease); break;
+    double steepest_graze = 0;  // the largest view angle of a front face, deg (at any vertex)
+    for (const auto& f : cube.faces)
+      for (int v : f.vertices) {
+        const Eigen::Vector3d to_eye = eye - cube.vertices[static_cast<std::size_t>(v)];
+        const double c = f.normal_obj.dot(to_eye) / to_eye.norm();
+        if (c > 0) steepest_graze = std::max(steepest_graze, std::acos(c) * 180 / M_PI);
+      }
+    const bool default_too = steepest_graze < 84;
+    for (int run = 0; run < (default_too ? 2 : 1); ++run) {
+      const VisibilityOptions options = run == 0 ? all_front : VisibilityOptions{};
+      for (const auto& e : compute_visibility(cube, camera, pose, options).edges) {
+        const Eigen::Vector2d mid = 0.5 * (e.a_px + e.b_px);
+        const Eigen::Vector2d d = (e.b_px - e.a_px).normalized();
+        const Eigen::Vector2d left(d.y(), -d.x());
+        // Just beside the edge: a face seen nearly edge-on may be under a pixel wide.
+        const bool on_left = pixel_on_object(cube, camera, pose, mid + 0.25 * left);
+        const bool on_right = pixel_on_object(cube, camera, pose, mid - 0.25 * left);
+        INFO("trial " << trial << " edge " << e.edge);
+        switch (e.side) {
+          case ObjectSide::Left: CHECK(on_left); CHECK_FALSE(on_right); break;
+          case ObjectSide::Right: CHECK(on_right); CHECK_FALSE(on_left); break;
+          case ObjectSide::Both: CHECK(on_left); CHECK(on_right); CHECK(e.kind == EdgeKind::Crease); break;
+        }
       }
     }
   }
@@ -255,6 +268,37 @@ TEST_CASE("a face seen nearly edge-on gives up its far edge, and its near edge b
   }
   CHECK(right == 2);  // the front and top edges of the sliver
   CHECK(out.edges.size() + 2 == strict.edges.size());
+}
+
+TEST_CASE("a face near the view-angle limit is decided once: all its edges agree", "[visibility]") {
+  // Sweep the camera so that the cube's x = 0.1 face passes through 85 deg: at every step either
+  // its far edges are gone and its near edges are contours, or all four edges are there with its
+  // near edges creases; never a mix (a side with no contour at all).
+  const CadModel cube = make_cube();
+  const Camera camera = test_camera();
+  auto on_right_face = [](const VisibleEdge& e) { return e.a_obj.x() > 0.099 && e.b_obj.x() > 0.099; };
+  int turned_away = 0, seen = 0;
+  for (double cx = 0.13; cx <= 0.19; cx += 0.0025) {
+    const auto pose = camera_at({cx, -0.5, 0.35}, {0.05, 0.05, 0.05});
+    int right = 0, contours = 0, creases = 0;
+    for (const auto& e : compute_visibility(cube, camera, pose).edges) {
+      if (!on_right_face(e)) continue;
+      ++right;
+      contours += e.kind == EdgeKind::Contour;
+      creases += e.kind == EdgeKind::Crease;
+    }
+    INFO("camera x " << cx);
+    if (right == 2) {
+      CHECK(contours == 2);
+      ++turned_away;
+    } else {
+      CHECK(right == 4);
+      CHECK(creases == 2);
+      ++seen;
+    }
+  }
+  CHECK(turned_away > 0);  // the sweep crosses the limit
+  CHECK(seen > 0);
 }
 
 TEST_CASE("edges between nearly coplanar facets are dropped unless on the silhouette", "[visibility]") {

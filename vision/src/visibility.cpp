@@ -66,7 +66,7 @@ Visibility::Visibility(const CadModel& model, const Camera& camera, const Visibi
   tri_x0_.resize(n); tri_x1_.resize(n); tri_y0_.resize(n); tri_y1_.resize(n);
   candidates_.reserve(n);
   face_front_.resize(model.faces.size());
-  face_height_m_.resize(model.faces.size());
+  face_seen_.resize(model.faces.size());
   hidden_.reserve(64);
 
   // The image frustum as the rectangle inscribed in the unprojected (undistorted) image border,
@@ -95,8 +95,19 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
 
   for (std::size_t f = 0; f < model.faces.size(); ++f) {
     const auto& face = model.faces[f];
-    face_height_m_[f] = face.normal_obj.dot(camera_obj) - face.offset_m;
-    face_front_[f] = face_height_m_[f] > 0;
+    const double height_m = face.normal_obj.dot(camera_obj) - face.offset_m;
+    face_front_[f] = height_m > 0;
+    // Seen within the angle where it is seen steepest, at its nearest vertex (cos = height /
+    // distance, tested without the division): one decision per face, so all of its edges agree,
+    // and a large face (a floor) that is steep near the camera counts as seen. Open models are
+    // seen from both sides (thin sheets) and keep the strict test.
+    bool seen = face_front_[f];
+    if (seen && model.closed && cos_max_view > 0) {
+      double nearest_m = std::numeric_limits<double>::infinity();
+      for (int v : face.vertices) nearest_m = std::min(nearest_m, (camera_obj - model.vertices[v]).norm());
+      seen = height_m > cos_max_view * nearest_m;
+    }
+    face_seen_[f] = seen;
   }
   for (std::size_t i = 0; i < model.vertices.size(); ++i) vertices_cam_[i] = R * model.vertices[i] + t;
 
@@ -229,15 +240,9 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
       // Facets of a smooth surface keep the strict front test: their silhouette is where the
       // surface turns away, however grazing the last facet. Across a sharp edge a face seen
       // nearly edge-on counts as turned away (VisibilityOptions::max_view_angle_rad).
-      // The view angle is taken at the edge (cos = height / distance to its middle, tested
-      // without the division): a large face can be steep near the camera and grazing far off.
       const bool smooth = model.faces[fa].normal_obj.dot(model.faces[fb].normal_obj) > cos_crease;
-      bool front_a = face_front_[fa], front_b = face_front_[fb];
-      if (!smooth) {
-        const double graze_m = cos_max_view * (camera_obj - 0.5 * (model.vertices[edge.v0] + model.vertices[edge.v1])).norm();
-        front_a = face_height_m_[fa] > graze_m;
-        front_b = face_height_m_[fb] > graze_m;
-      }
+      const bool front_a = smooth ? face_front_[fa] : face_seen_[fa];
+      const bool front_b = smooth ? face_front_[fb] : face_seen_[fb];
       if (front_a != front_b) {
         kind = EdgeKind::Contour;
         side_face = front_a ? 0 : 1;

@@ -53,12 +53,13 @@ struct VisibilityOptions {
   double near_m = 0.01;        // near clipping plane
   double margin_px = 0;        // clip edges to the image shrunk by this margin
   double min_length_px = 2.0;  // visible pieces shorter than this are dropped
-  // Across a sharp edge (faces further apart than the crease angle), a face seen at a larger
-  // angle between its normal and the line of sight counts as turned away: its far edge is not
-  // tracked and its near edge becomes a contour. Near edge-on a face projects to a sliver (at
-  // 85 deg, under a tenth of its width): the windows of its two edges see the same image edge,
-  // and the far one pulls the pose. The same test as ViSP's face appearance angle. 90 deg
-  // keeps every front face; facets of smooth surfaces always keep the strict test.
+  // Across a sharp edge (faces further apart than the crease angle) of a closed model, a face
+  // seen at a larger angle between its normal and the line of sight (to its nearest vertex)
+  // counts as turned away: its far edges are not tracked and its near edges become contours.
+  // Near edge-on a face projects to a sliver (at 85 deg, under a tenth of its width): the
+  // windows of its two edges see the same image edge, and the far one pulls the pose. Like
+  // ViSP's face appearance angle (which measures from the face's centre). 90 deg keeps every
+  // front face; facets of smooth surfaces and open models always keep the strict test.
   double max_view_angle_rad = 85.0 * 3.14159265358979323846 / 180.0;
 };
 
@@ -90,7 +91,7 @@ class Visibility {
   std::vector<float> tri_x0_, tri_x1_, tri_y0_, tri_y1_;
   std::vector<int> candidates_;  // scratch: triangles whose box meets the edge's
   std::vector<unsigned char> face_front_;  // the camera is on the face's outer side
-  std::vector<double> face_height_m_;      // the camera's signed distance from the face's plane
+  std::vector<unsigned char> face_seen_;   // ... and sees it within max_view_angle_rad (closed models)
   std::vector<std::pair<double, double>> hidden_;  // scratch intervals
   double xn_min_ = 0, xn_max_ = 0, yn_min_ = 0, yn_max_ = 0;  // image bounds, normalised
 };
