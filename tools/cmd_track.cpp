@@ -197,7 +197,7 @@ int run_track(const TrackArgs& args) {
         ++fused_frames;
       }
     poses.push_back({entry.frame, entry.t_s, estimate, to_string(report.status)});
-    vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
+    if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
     per_frame.push_back({{"frame", entry.frame},
                          {"t_s", entry.t_s},
                          {"status", to_string(report.status)},

@@ -56,6 +56,12 @@ done
 # The largest peak rate with >= 99 % success (the target's bar), per scenario and IMU setting
 # (monotone: the first failing jerk ends the run); beside it the same at >= 95 %, since on a
 # 150-frame run the 99 % bar falls at the second frame a few tenths of a degree past 5 deg.
+best() {  # scenario (from the loop), IMU setting, success bar
+  awk -F, -v s="$scenario" -v i="$1" -v bar="$2" '$1==s && $4==i { if (!failed && $5 >= bar) best=$3; else failed=1 } END { printf "%.0f", best+0 }' "$csv"
+}
+# The fastest run of a setting with >= 99 % success, slower failures or not.
+any() { awk -F, -v s="$scenario" -v i="$1" '$1==s && $4==i && $5 >= 0.99 && $3 > best { best=$3 } END { printf "%.0f", best+0 }' "$csv"; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f", a / b; else print "n/a" }'; }
 {
   echo "## Trackable speed with and without IMU prediction"
   echo
@@ -70,10 +76,6 @@ done
   echo "| scenario | without IMU (deg/s) | IMU, calibrated offset | ratio | IMU, estimated offset | ratio | 95 %: without / estimated |"
   echo "|---|---|---|---|---|---|---|"
   for scenario in mockup_walk box_clutter; do
-    best() {  # IMU setting, success bar
-      awk -F, -v s="$scenario" -v i="$1" -v bar="$2" '$1==s && $4==i { if (!failed && $5 >= bar) best=$3; else failed=1 } END { printf "%.0f", best+0 }' "$csv"
-    }
-    ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f", a / b; else print "n/a" }'; }
     off=$(best off 0.99); cal=$(best calibrated 0.99); est=$(best estimated 0.99)
     off95=$(best off 0.95); est95=$(best estimated 0.95)
     echo "| $scenario | $off | $cal | $(ratio "$cal" "$off") | $est | $(ratio "$est" "$off") | $off95 / $est95 ($(ratio "$est95" "$off95")) |"
@@ -87,8 +89,6 @@ done
   echo "| scenario | fastest passing run: without IMU | calibrated | ratio | estimated | ratio |"
   echo "|---|---|---|---|---|---|"
   for scenario in mockup_walk box_clutter; do
-    any() { awk -F, -v s="$scenario" -v i="$1" '$1==s && $4==i && $5 >= 0.99 && $3 > best { best=$3 } END { printf "%.0f", best+0 }' "$csv"; }
-    ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f", a / b; else print "n/a" }'; }
     off=$(any off); cal=$(any calibrated); est=$(any estimated)
     echo "| $scenario | $off | $cal | $(ratio "$cal" "$off") | $est | $(ratio "$est" "$off") |"
   done

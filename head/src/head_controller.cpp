@@ -435,14 +435,10 @@ ControlOutput HeadController::step(const ControlInput& in) {
   c.tilt_rate_radps = wire_rate(tilt_cmd_.rate_radps, counters_.encode_clipped);
   c.counter = counter_;
   if (out.dispatch == Dispatch::Send) {
-    if (pan_backlash_.active() || tilt_backlash_.active()) {
-      // A joint without backlash: its output moves with the motor, at the rate on the wire.
-      if (!pan_backlash_.active()) output_rates.x() = c.pan_rate_radps;
-      if (!tilt_backlash_.active()) output_rates.y() = c.tilt_rate_radps;
-      joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps}, output_rates);
-    } else {
-      joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps});
-    }
+    // A joint without backlash: its output moves with the motor, at the rate on the wire.
+    if (!pan_backlash_.active()) output_rates.x() = c.pan_rate_radps;
+    if (!tilt_backlash_.active()) output_rates.y() = c.tilt_rate_radps;
+    joint_rates_.sent(t, {c.pan_rate_radps, c.tilt_rate_radps}, output_rates);
     counter_ = static_cast<std::uint8_t>((counter_ + 1) & 0x0f);
     ++counters_.sent;
   } else {

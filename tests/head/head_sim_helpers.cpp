@@ -164,4 +164,22 @@ const ControlOutput& ClosedLoop::tick() {
   return out;
 }
 
+RateRms camera_rate_rms(const HeadControllerOptions& o, const PlantOptions& plant, double seconds, std::uint64_t seed,
+                        bool stabilise) {
+  auto controller = HeadController::create(o);
+  REQUIRE(controller);
+  ClosedLoop loop(std::move(*controller), HeadPlant(o.mount, plant, walking_bursts(seconds, seed), {0.0, 0.1}));
+  loop.controller().request(ControlMode::Stabilise);
+  double sxy = 0, sall = 0;
+  const int ticks = static_cast<int>(seconds * 1000);
+  for (int i = 0; i < ticks; ++i) {
+    if (stabilise) loop.tick();
+    else loop.plant().advance_to((i + 1) * 1e-3);
+    const Eigen::Vector3d w = loop.plant().true_camera_rate();
+    sxy += w.head<2>().squaredNorm();
+    sall += w.squaredNorm();
+  }
+  return {std::sqrt(sxy / ticks), std::sqrt(sall / ticks)};
+}
+
 }  // namespace epichead::head::testing

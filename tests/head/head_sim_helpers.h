@@ -126,5 +126,10 @@ void require_within_position_and_rate_limits(const firmware_iface::HeadCommand& 
 struct RateRms {
   double xy_radps = 0, all_radps = 0;
 };
+// `seconds` of walking bursts (seed) on a head with plant options `plant`, 1 kHz ticks: the
+// controller built from `o` in Stabilise, or (stabilise false) no commands at all, the head
+// holding still. Returns the camera's true rate RMS over every tick.
+RateRms camera_rate_rms(const HeadControllerOptions& o, const PlantOptions& plant, double seconds, std::uint64_t seed,
+                        bool stabilise);
 
 }  // namespace epichead::head::testing

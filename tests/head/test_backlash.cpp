@@ -80,14 +80,10 @@ TEST_CASE("with backlash 0 the commands are bit-identical to the controller befo
 
 namespace {
 
-struct Rms {
-  double xy = 0, all = 0;
-};
-
 // Stabilise through walking bursts on a head with gear backlash; the controller's calibration
 // says backlash_rad (0: no compensation). `fixed`: no commands at all (the head holds still).
-Rms stabilise_rms(double plant_backlash_rad, double controller_backlash_rad, bool fixed, double seconds,
-                  std::uint64_t seed, double gyro_noise_radps = 0.008) {
+RateRms stabilise_rms(double plant_backlash_rad, double controller_backlash_rad, bool fixed, double seconds,
+                      std::uint64_t seed, double gyro_noise_radps = 0.008) {
   PlantOptions po;  // 2 ms motor lag, 0.5 ms command latency
   po.backlash_rad = plant_backlash_rad;
   po.gyro_noise_radps = gyro_noise_radps;
@@ -96,21 +92,7 @@ Rms stabilise_rms(double plant_backlash_rad, double controller_backlash_rad, boo
   o.joint_rates.command_delay_s = po.command_latency_s + 0.001;
   o.joint_rates.motor_lag_s = po.motor_lag_s;
   o.backlash = {controller_backlash_rad, controller_backlash_rad};
-  auto controller = HeadController::create(o);
-  REQUIRE(controller);
-  HeadPlant plant(o.mount, po, walking_bursts(seconds, seed), {0.0, 0.1});
-  ClosedLoop loop(std::move(*controller), std::move(plant));
-  loop.controller().request(ControlMode::Stabilise);
-  double sxy = 0, sall = 0;
-  const int ticks = static_cast<int>(seconds * 1000);
-  for (int i = 0; i < ticks; ++i) {
-    if (fixed) loop.plant().advance_to((i + 1) * 1e-3);
-    else loop.tick();
-    const Eigen::Vector3d w = loop.plant().true_camera_rate();
-    sxy += w.head<2>().squaredNorm();
-    sall += w.squaredNorm();
-  }
-  return {std::sqrt(sxy / ticks), std::sqrt(sall / ticks)};
+  return camera_rate_rms(o, po, seconds, seed, !fixed);
 }
 
 }  // namespace
@@ -123,16 +105,16 @@ TEST_CASE("backlash compensation lowers the camera's x/y rate RMS on a head with
   constexpr double backlash = 0.0005;  // the simulator's default head (sim/head_dynamics.h)
   const double noise = GENERATE(0.0, 0.008);
   for (std::uint64_t seed : {1u, 2u}) {
-    const Rms fixed = stabilise_rms(backlash, 0, true, 8.0, seed, noise);
-    const Rms off = stabilise_rms(backlash, 0, false, 8.0, seed, noise);
-    const Rms on = stabilise_rms(backlash, backlash, false, 8.0, seed, noise);
-    const Rms ideal = stabilise_rms(0, 0, false, 8.0, seed, noise);
-    INFO("noise " << noise << " seed " << seed << ": x/y RMS fixed " << fixed.xy << ", no backlash " << ideal.xy << ", backlash uncompensated "
-                 << off.xy << ", compensated " << on.xy << " rad/s");
-    CHECK(fixed.xy > 0.15);
-    CHECK(ideal.xy < off.xy);
-    CHECK(on.xy < 0.95 * off.xy);
-    CHECK(off.xy - on.xy > 0.35 * (off.xy - ideal.xy));  // at least a third of what the backlash costs
+    const RateRms fixed = stabilise_rms(backlash, 0, true, 8.0, seed, noise);
+    const RateRms off = stabilise_rms(backlash, 0, false, 8.0, seed, noise);
+    const RateRms on = stabilise_rms(backlash, backlash, false, 8.0, seed, noise);
+    const RateRms ideal = stabilise_rms(0, 0, false, 8.0, seed, noise);
+    INFO("noise " << noise << " seed " << seed << ": x/y RMS fixed " << fixed.xy_radps << ", no backlash " << ideal.xy_radps << ", backlash uncompensated "
+                 << off.xy_radps << ", compensated " << on.xy_radps << " rad/s");
+    CHECK(fixed.xy_radps > 0.15);
+    CHECK(ideal.xy_radps < off.xy_radps);
+    CHECK(on.xy_radps < 0.95 * off.xy_radps);
+    CHECK(off.xy_radps - on.xy_radps > 0.35 * (off.xy_radps - ideal.xy_radps));  // at least a third of what the backlash costs
   }
 }
 

@@ -41,6 +41,9 @@ CadModel make_prism(const std::vector<Eigen::Vector2d>& profile_ccw, double heig
   return *model;
 }
 
+// An edge of make_cube()'s x = 0.1 face.
+bool on_cube_x_max_face(const VisibleEdge& e) { return e.a_obj.x() > 0.099 && e.b_obj.x() > 0.099; }
+
 CadModel make_cube() { return make_prism({{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}}, 0.1); }
 
 CadModel make_l_shape() {
@@ -241,8 +244,7 @@ TEST_CASE("a face seen nearly edge-on gives up its far edge, and its near edge b
   const CadModel cube = make_cube();
   const Camera camera = test_camera();
   const auto pose = camera_at({0.12, -0.5, 0.35}, {0.05, 0.05, 0.05});
-  auto on_right_face = [](const VisibleEdge& e) { return e.a_obj.x() > 0.099 && e.b_obj.x() > 0.099; };
-  auto far_vertical = [&](const VisibleEdge& e) { return on_right_face(e) && e.a_obj.y() > 0.099 && e.b_obj.y() > 0.099; };
+  auto far_vertical = [&](const VisibleEdge& e) { return on_cube_x_max_face(e) && e.a_obj.y() > 0.099 && e.b_obj.y() > 0.099; };
 
   VisibilityOptions all_front;
   all_front.max_view_angle_rad = M_PI / 2;
@@ -250,8 +252,8 @@ TEST_CASE("a face seen nearly edge-on gives up its far edge, and its near edge b
   int far = 0, right_creases = 0, right_strict = 0;
   for (const auto& e : strict.edges) {
     far += far_vertical(e);
-    right_strict += on_right_face(e);
-    right_creases += on_right_face(e) && e.kind == EdgeKind::Crease;
+    right_strict += on_cube_x_max_face(e);
+    right_creases += on_cube_x_max_face(e) && e.kind == EdgeKind::Crease;
   }
   CHECK(right_strict == 4);   // 90 deg: all four edges of the sliver: its far vertical and
   CHECK(far == 1);            // bottom edges (contours) ...
@@ -261,7 +263,7 @@ TEST_CASE("a face seen nearly edge-on gives up its far edge, and its near edge b
   int right = 0;
   for (const auto& e : out.edges) {
     CHECK_FALSE(far_vertical(e));
-    if (!on_right_face(e)) continue;
+    if (!on_cube_x_max_face(e)) continue;
     ++right;
     CHECK(e.kind == EdgeKind::Contour);
     CHECK(e.side != ObjectSide::Both);
@@ -276,13 +278,12 @@ TEST_CASE("a face near the view-angle limit is decided once: all its edges agree
   // near edges creases; never a mix (a side with no contour at all).
   const CadModel cube = make_cube();
   const Camera camera = test_camera();
-  auto on_right_face = [](const VisibleEdge& e) { return e.a_obj.x() > 0.099 && e.b_obj.x() > 0.099; };
   int turned_away = 0, seen = 0;
   for (double cx = 0.13; cx <= 0.19; cx += 0.0025) {
     const auto pose = camera_at({cx, -0.5, 0.35}, {0.05, 0.05, 0.05});
     int right = 0, contours = 0, creases = 0;
     for (const auto& e : compute_visibility(cube, camera, pose).edges) {
-      if (!on_right_face(e)) continue;
+      if (!on_cube_x_max_face(e)) continue;
       ++right;
       contours += e.kind == EdgeKind::Contour;
       creases += e.kind == EdgeKind::Crease;
