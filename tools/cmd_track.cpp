@@ -41,6 +41,7 @@ struct TrackArgs {
   double crease_deg = 20.0;
   double max_view_deg = 85.0;
   std::string imu_time_offset = "auto";
+  std::uint32_t ransac_seed = RansacOptions{}.seed;
 };
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
@@ -152,6 +153,7 @@ int run_track(const TrackArgs& args) {
   options.mode = mode->second;
   options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
   options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
+  options.lines.epic.ransac.seed = args.ransac_seed;
   ModelTracker tracker(seq->model(), seq->camera(), options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
@@ -323,6 +325,8 @@ const CommandRegistration registration{
       app.add_option("--max-view-deg", a->max_view_deg,
                      "Faces seen more edge-on than this (angle of normal to line of sight) count as turned away (default 85; 90: all front faces)")
           ->check(CLI::Range(0.0, 90.0));
+      app.add_option("--ransac-seed", a->ransac_seed,
+                     "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");
       return [a]() { return run_track(*a); };
     }};
 

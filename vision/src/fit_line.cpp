@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace epichead::vision {
 
@@ -23,11 +28,15 @@ WindowLine fit_line_tls(const float* x_px, const float* s_px, const int* idx, in
     sss += ds * ds;
     sxs += dx * ds;
   }
-  // Direction of largest spread in (s, x): angle of the principal axis of the 2x2 scatter.
-  // A window line is near-vertical (along s), so cos(theta) is far from 0; guard anyway.
-  const double theta = 0.5 * std::atan2(2.0 * sxs, sss - sxx);
-  const double cs = std::cos(theta), sn = std::sin(theta);
-  const double m = std::fabs(cs) > 1e-6 ? sn / cs : 0.0;
+  // Direction of largest spread in (s, x): the principal axis of the 2x2 scatter is at
+  // theta = atan2(b, a) / 2 from the s axis, a = sss - sxx, b = 2 sxs, and its slope is
+  // tan(theta) = b / (r + a), r = |(a, b)| (the half-angle formula: no atan2, cos or sin, which
+  // were most of the refinement's cost). A window line is near-vertical (along s), so a > 0 and
+  // r + a is far from 0; a line across the window (r + a ~ 0, slope beyond 1e6) gets m = 0.
+  const double a = sss - sxx, b = 2.0 * sxs;
+  const double r = std::sqrt(a * a + b * b);
+  const double m_axis = r + a > 0 ? b / (r + a) : 0.0;
+  const double m = std::fabs(m_axis) < 1e6 ? m_axis : 0.0;
   line.m = static_cast<float>(m);
   line.c = static_cast<float>(mx - m * ms);
   return line;
@@ -38,7 +47,7 @@ LineRansac::LineRansac(const RansacOptions& options, int max_points)
   hypotheses_.reserve(32);
   candidates_.reserve(32);
   inliers_.reserve(static_cast<std::size_t>(max_points_) * 32);
-  scratch_.reserve(max_points_);
+  scratch_.assign(max_points_, 0);  // collect_inliers writes indices into it (count apart)
   claimed_.assign(max_points_, 0);
 }
 
@@ -67,7 +76,11 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   const int max_keep = std::max(1, options_.max_candidates);
   const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
   if (n < std::max(2, options_.min_support)) return 0;
-  rng_ = 0x9E3779B9u;
+  // The seed through a 32-bit mixer (MurmurHash3's finaliser): small seeds would otherwise start
+  // xorshift on small numbers, and the top bits that pick the indices would be 0 for a while.
+  rng_ = options_.seed;
+  rng_ ^= rng_ >> 16; rng_ *= 0x85EBCA6Bu; rng_ ^= rng_ >> 13; rng_ *= 0xC2B2AE35u; rng_ ^= rng_ >> 16;
+  if (rng_ == 0) rng_ = 1;  // the one state xorshift cannot leave
   auto next = [this] {  // xorshift32: deterministic, cheap, good enough for sampling
     rng_ ^= rng_ << 13; rng_ ^= rng_ >> 17; rng_ ^= rng_ << 5;
     return rng_;
@@ -85,8 +98,9 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   int best = 0;
   int budget = options_.max_iterations;
   for (; iterations_ < budget; ++iterations_) {
-    const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n));
-    int j = static_cast<int>(next() % static_cast<std::uint32_t>(n - 1));
+    // Indices by multiply-shift (the top bits of r * n): no integer division.
+    const int i = static_cast<int>((std::uint64_t{next()} * static_cast<std::uint32_t>(n)) >> 32);
+    int j = static_cast<int>((std::uint64_t{next()} * static_cast<std::uint32_t>(n - 1)) >> 32);
     if (j >= i) ++j;
     const float ds = s[j] - s[i];
     if (std::fabs(ds) < 1e-3f) continue;  // same row: no near-vertical line through both
@@ -123,23 +137,36 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   const float tol = options_.inlier_distance_px;
   std::fill(claimed_.begin(), claimed_.begin() + n, 0);
   // The points within tol of a line into scratch_: WindowLine::distance with its root taken
-  // once per line instead of once per point (the same operations, so the same decisions).
+  // once per line instead of once per point (the same operations, so the same decisions), four
+  // points per SSE pass and their indices written from the compare mask.
+  int found = 0;
   auto collect_inliers = [&](const WindowLine& line) {
-    scratch_.clear();
     const float norm = std::sqrt(1.0f + line.m * line.m);
-    for (int k = 0; k < n; ++k)
-      if (std::fabs(x[k] - line.m * s[k] - line.c) / norm <= tol) scratch_.push_back(k);
+    int* out = scratch_.data();
+    int count = 0, k = 0;
+#if defined(__SSE2__)
+    const __m128 vm = _mm_set1_ps(line.m), vc = _mm_set1_ps(line.c), vnorm = _mm_set1_ps(norm), vtol = _mm_set1_ps(tol);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    for (; k + 4 <= n; k += 4) {
+      const __m128 r = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(x + k), _mm_mul_ps(vm, _mm_loadu_ps(s + k))), vc);
+      const __m128 d = _mm_div_ps(_mm_andnot_ps(sign, r), vnorm);
+      for (int bits = _mm_movemask_ps(_mm_cmple_ps(d, vtol)); bits != 0; bits &= bits - 1) out[count++] = k + __builtin_ctz(bits);
+    }
+#endif
+    for (; k < n; ++k)
+      if (std::fabs(x[k] - line.m * s[k] - line.c) / norm <= tol) out[count++] = k;
+    found = count;
   };
   for (const Hypothesis& h : hypotheses_) {
     if (h.support < keep * best) continue;
     WindowLine line = h.line;
     for (int pass = 0; pass < 2; ++pass) {
       collect_inliers(line);
-      if (static_cast<int>(scratch_.size()) < 2) break;
-      line = fit_line_tls(x, s, scratch_.data(), static_cast<int>(scratch_.size()));
+      if (found < 2) break;
+      line = fit_line_tls(x, s, scratch_.data(), found);
     }
     collect_inliers(line);
-    const int support = static_cast<int>(scratch_.size());
+    const int support = found;
     if (support < options_.min_support) continue;
     // Refinement can pull two hypotheses onto one line: keep the first (stronger) one.
     bool duplicate = false;
@@ -149,14 +176,14 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
     // own: two close parallel edges make diagonals that cross both within the inlier band.
     // Hypotheses come strongest first, so this is decided in support order.
     int exclusive = 0;
-    for (int k : scratch_) exclusive += !claimed_[k];
+    for (int q = 0; q < found; ++q) exclusive += !claimed_[scratch_[q]];
     if (exclusive < keep * best || exclusive < options_.min_support) continue;
-    for (int k : scratch_) claimed_[k] = 1;
+    for (int q = 0; q < found; ++q) claimed_[scratch_[q]] = 1;
     LineFit fit;
     fit.line = line;
     fit.support = support;
     fit.inlier_begin = static_cast<int>(inliers_.size());
-    inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.end());
+    inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.begin() + found);
     candidates_.push_back(fit);
   }
   // Insertion sort (a handful of candidates; std::stable_sort would allocate a buffer).

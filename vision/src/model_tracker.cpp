@@ -98,6 +98,13 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   }
   kept_last_.assign(edges, kNotVisible);
   kept_now_.assign(edges, kNotVisible);
+  // The estimator's and the result's per-feature buffers at the model's full size.
+  std::size_t observations = 0;
+  for (const LineObservation& obs : problem_.lines) observations += obs.edgels_px.capacity();
+  for (const EllipseObservation& obs : problem_.ellipses) observations += obs.points_px.capacity();
+  const std::size_t slots = edges + model.vertices.size() + model.circles.size();
+  estimator_.reserve(slots, observations);
+  pose_.residuals.reserve(slots);
 }
 
 void ModelTracker::reset() {

@@ -123,6 +123,14 @@ PoseEstimator::PoseEstimator(const Camera& camera, const PoseOptions& options) :
   residual_scratch_.reserve(4096);
 }
 
+void PoseEstimator::reserve(std::size_t slots, std::size_t observations) {
+  rejected_.reserve(slots);
+  feature_sq_.reserve(slots);
+  feature_n_.reserve(slots);
+  offsets_.reserve(slots);
+  normalized_.reserve(observations);
+}
+
 void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d& prior, PoseResult& out) {
   out.cam_T_obj = prior;
   out.status = PoseStatus::Ok;

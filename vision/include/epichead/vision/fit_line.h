@@ -29,6 +29,10 @@ struct RansacOptions {
   int max_iterations = 500;        // cap on Eq. 4 (w near 0)
   int min_support = 3;             // fewer inliers than this is no line at all
   float min_separation_px = 2.0f;  // distinct candidates differ by this much at either window end
+  // Start of the sampler's random sequence, re-applied for every window (deterministic runs).
+  // Another seed draws other point pairs: how much a result moves with it shows how much it
+  // hangs on the draw (docs/epic.md, "Seed spread").
+  std::uint32_t seed = 0x9E3779B9u;
 };
 
 // One fitted line with its support; inliers are indices into the points given to fit(), stored

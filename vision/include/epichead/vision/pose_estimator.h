@@ -98,6 +98,10 @@ class PoseEstimator {
   PoseEstimator(const Camera& camera, const PoseOptions& options = {});
   // Refines `prior_cam_T_obj` on the problem's features; `out` is reused between calls.
   void estimate(const PoseProblem& problem, const Eigen::Isometry3d& prior_cam_T_obj, PoseResult& out);
+  // Sizes the scratch buffers for problems of up to `slots` features (lines, points and
+  // ellipses) and `observations` edgels and ellipse points, so that estimate() does not grow
+  // them on the first frame that sees more of the model than any before.
+  void reserve(std::size_t slots, std::size_t observations);
 
  private:
   Camera camera_;
