@@ -76,11 +76,7 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   const int max_keep = std::max(1, options_.max_candidates);
   const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
   if (n < std::max(2, options_.min_support)) return 0;
-  // The seed through a 32-bit mixer (MurmurHash3's finaliser): small seeds would otherwise start
-  // xorshift on small numbers, and the top bits that pick the indices would be 0 for a while.
-  rng_ = options_.seed;
-  rng_ ^= rng_ >> 16; rng_ *= 0x85EBCA6Bu; rng_ ^= rng_ >> 13; rng_ *= 0xC2B2AE35u; rng_ ^= rng_ >> 16;
-  if (rng_ == 0) rng_ = 1;  // the one state xorshift cannot leave
+  rng_ = options_.seed != 0 ? options_.seed : 1u;  // 0 is the one state xorshift cannot leave
   auto next = [this] {  // xorshift32: deterministic, cheap, good enough for sampling
     rng_ ^= rng_ << 13; rng_ ^= rng_ >> 17; rng_ ^= rng_ << 5;
     return rng_;
@@ -98,9 +94,8 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   int best = 0;
   int budget = options_.max_iterations;
   for (; iterations_ < budget; ++iterations_) {
-    // Indices by multiply-shift (the top bits of r * n): no integer division.
-    const int i = static_cast<int>((std::uint64_t{next()} * static_cast<std::uint32_t>(n)) >> 32);
-    int j = static_cast<int>((std::uint64_t{next()} * static_cast<std::uint32_t>(n - 1)) >> 32);
+    const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n));
+    int j = static_cast<int>(next() % static_cast<std::uint32_t>(n - 1));
     if (j >= i) ++j;
     const float ds = s[j] - s[i];
     if (std::fabs(ds) < 1e-3f) continue;  // same row: no near-vertical line through both

@@ -31,7 +31,7 @@ struct RansacOptions {
   float min_separation_px = 2.0f;  // distinct candidates differ by this much at either window end
   // Start of the sampler's random sequence, re-applied for every window (deterministic runs).
   // Another seed draws other point pairs: how much a result moves with it shows how much it
-  // hangs on the draw (docs/epic.md, "Seed spread").
+  // hangs on the draw (docs/epic.md, sixth pass). 0, the one state xorshift cannot leave, means 1.
   std::uint32_t seed = 0x9E3779B9u;
 };
 
