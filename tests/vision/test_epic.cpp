@@ -73,12 +73,13 @@ struct Runner {
   EpicResult result;
   FeatureReferences refs;
   explicit Runner(const EpicOptions& o = {}) : options(o), detector(o) { result.reserve({}, o.ransac); }
-  void run(const cv::Mat& img, const Eigen::Vector2d& a, const Eigen::Vector2d& b, ObjectSide side, EpicMode mode) {
+  void run(const cv::Mat& img, const Eigen::Vector2d& a, const Eigen::Vector2d& b, ObjectSide side, EpicMode mode,
+           bool look_through = false) {
     WindowImage wi;
     REQUIRE(wi.assign(img).has_value());
     REQUIRE(window.sample(wi, a, b));
     if (!refs.initialised) detector.init_references(window, side, refs);
-    detector.detect(window, side, refs, mode, result);
+    detector.detect(window, side, refs, mode, result, look_through);
   }
 };
 
@@ -258,4 +259,52 @@ TEST_CASE("windows without edges or outside the image give no candidate and do n
   Runner grad;
   grad.run(flat, {50, 10}, {50, 90}, ObjectSide::Left, EpicMode::Gradient);
   CHECK_FALSE(grad.result.found());
+}
+
+TEST_CASE("look-through keeps a contour with a thin printed border; without it EPIC takes the border's inner edge", "[epic]") {
+  // A dark face (x > 63) with a 3 px lighter border strip (60 < x < 63) on a light background:
+  // the model's contour is x = 60. The contour's edgels have the strip on their object side,
+  // emptied by the edge margins, so without look-through they get no evidence (C = 0) and the
+  // inner edge of the border (x = 63) wins; with it they see the face beyond the strip too.
+  const Colour face(60, 60, 60), strip(130, 130, 130), background(230, 230, 230);
+  const cv::Mat img = render(120, 120, [&](double x, double) { return x > 63.0 ? face : (x > 60.0 ? strip : background); },
+                             0.7, 1.0);
+  const Eigen::Vector2d a(60.5, 20), b(60.5, 100);  // a -> b runs down: the face is on the Left
+  const Eigen::Vector2d contour_a(60, 0), contour_b(60, 120), inner_a(63, 0), inner_b(63, 120);
+  auto on = [](const LineCandidate& c, const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+    return line_distance(c.a_px, p, q) < 0.7 && line_distance(c.b_px, p, q) < 0.7;
+  };
+  // Mean likelihood of the edgels near window offset x (columns run toward -x: x = 60 is +0.5).
+  auto mean_likelihood = [](const EpicResult& r, float x_px) {
+    double sum = 0;
+    int n = 0;
+    for (const Edgel& e : r.edgels.edgels)
+      if (std::abs(e.x_px - x_px) < 1.0f) { sum += e.likelihood; ++n; }
+    return n > 0 ? sum / n : -1.0;
+  };
+
+  Runner plain;
+  plain.run(img, a, b, ObjectSide::Left, EpicMode::Epic, false);
+  REQUIRE(plain.result.found());
+  CHECK(on(plain.result.candidates.front(), inner_a, inner_b));
+  for (const LineCandidate& c : plain.result.candidates) CHECK_FALSE(on(c, contour_a, contour_b));
+  CHECK(mean_likelihood(plain.result, 0.5f) < 0.1);
+
+  Runner through;
+  through.run(img, a, b, ObjectSide::Left, EpicMode::Epic, true);
+  REQUIRE(through.result.found());
+  bool contour = false;
+  for (const LineCandidate& c : through.result.candidates) contour = contour || on(c, contour_a, contour_b);
+  CHECK(contour);
+  CHECK(mean_likelihood(through.result, 0.5f) > 0.8);
+  CHECK(through.result.look_through);
+  // The reference update reads the intervals the likelihood used: the face's, not the strip's.
+  const int contour_candidate = [&] {
+    for (int k = 0; k < static_cast<int>(through.result.candidates.size()); ++k)
+      if (on(through.result.candidates[k], contour_a, contour_b)) return k;
+    return 0;
+  }();
+  FeatureReferences refs = through.refs;
+  through.detector.update_references(through.result, through.result.candidates[contour_candidate], ObjectSide::Left, refs);
+  CHECK(refs.side[0].mu[static_cast<int>(CueChannel::Intensity)] == Approx(60.0).margin(8.0));
 }

@@ -26,6 +26,17 @@ struct Moments {
   double var(int k) const { return std::max(0.0, sum_sq[k] / n - mean(k) * mean(k)); }
 };
 
+// The interval whose cues stand for side k (0: left, 1: right) of edgel i: its own, or with
+// look-through, when that one is empty, the one beyond the neighbouring edgel of the same row.
+int side_interval(const EdgelSet& set, const std::vector<IntervalCues>& intervals, int i, int k, bool look_through) {
+  const Edgel& e = set.edgels[static_cast<std::size_t>(i)];
+  const int own = e.left_interval + k;
+  if (!look_through || own >= static_cast<int>(intervals.size()) || intervals[static_cast<std::size_t>(own)].valid) return own;
+  const int neighbour = k == 0 ? i - 1 : i + 1;
+  if (neighbour < set.row_begin[e.row] || neighbour >= set.row_begin[e.row + 1]) return own;
+  return set.edgels[static_cast<std::size_t>(neighbour)].left_interval + k;
+}
+
 }  // namespace
 
 void EpicResult::reserve(const WindowOptions& window, const RansacOptions& ransac) {
@@ -74,8 +85,9 @@ void EpicDetector::init_references(const LineWindow& window, ObjectSide side, Fe
 }
 
 void EpicDetector::detect(const LineWindow& window, ObjectSide side, const FeatureReferences& refs,
-                          EpicMode mode, EpicResult& out) {
+                          EpicMode mode, EpicResult& out, bool look_through) {
   out.geometry = window.geometry();
+  out.look_through = look_through && mode != EpicMode::Gradient;
   out.intervals.clear();
   out.good.clear();
   out.candidates.clear();
@@ -105,8 +117,14 @@ void EpicDetector::likelihoods(EpicResult& out, ObjectSide side, const FeatureRe
   if (wr > 0) cue_agreements(out.intervals.data(), ni, refs.side[1], colour, agree_right_.data());
   else std::fill(agree_right_.begin(), agree_right_.begin() + ni, 0.0f);
   const float inv_w = 1.0f / (static_cast<float>(cue_count(colour)) * (wl + wr));
-  for (Edgel& e : out.edgels.edgels)
-    e.likelihood = (agree_left_[e.left_interval] + agree_right_[e.left_interval + 1]) * inv_w;
+  EdgelSet& set = out.edgels;
+  if (!out.look_through) {
+    for (Edgel& e : set.edgels) e.likelihood = (agree_left_[e.left_interval] + agree_right_[e.left_interval + 1]) * inv_w;
+    return;
+  }
+  for (int i = 0; i < static_cast<int>(set.edgels.size()); ++i)
+    set.edgels[i].likelihood = (agree_left_[side_interval(set, out.intervals, i, 0, true)] +
+                                agree_right_[side_interval(set, out.intervals, i, 1, true)]) * inv_w;
 }
 
 void EpicDetector::select_good_epic(EpicResult& out) const {
@@ -173,8 +191,9 @@ void EpicDetector::update_references(const EpicResult& result, const LineCandida
     if (!used) continue;
     Moments m;
     for (int q = 0; q < selected.support; ++q) {
-      const Edgel& e = result.edgels.edgels[result.inliers[selected.inlier_begin + q]];
-      const int j = e.left_interval + k;  // k = 0: interval on the left, 1: on the right
+      // k = 0: the interval on the left, 1: on the right (the ones the likelihood used)
+      const int j = side_interval(result.edgels, result.intervals, result.inliers[selected.inlier_begin + q], k,
+                                  result.look_through);
       if (j < static_cast<int>(result.intervals.size()) && result.intervals[j].valid) m.add(result.intervals[j]);
     }
     if (m.n < 3) continue;

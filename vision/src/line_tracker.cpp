@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace epichead::vision {
 
@@ -47,11 +48,35 @@ void LineTracker::detect(const WindowImage& image, const VisibleModel& visible, 
     f.visible = f.found = false;
     f.selected = -1;
     if (longest_[k] < 0) { f.has_previous = false; continue; }  // hidden: re-project when it returns
-    detect_one(image, visible.edges[longest_[k]], placement, f);
+    detect_one(image, visible.edges[longest_[k]], placement, options_.look_through && !has_close_parallel(visible, k), f);
   }
 }
 
-void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f) {
+// Another visible edge within parallel_reach_deg of this one's direction, less than half a window
+// width from its midpoint and alongside it: a window on this edge could see it as the neighbour.
+bool LineTracker::has_close_parallel(const VisibleModel& visible, int edge) const {
+  const VisibleEdge& me = visible.edges[static_cast<std::size_t>(longest_[static_cast<std::size_t>(edge)])];
+  const Eigen::Vector2d mid = 0.5 * (me.a_px + me.b_px);
+  const Eigen::Vector2d dir = (me.b_px - me.a_px).normalized();
+  const double reach_px = 0.5 * options_.window.width_px;
+  const double max_sin = std::sin(options_.parallel_reach_deg * std::numbers::pi / 180.0);
+  for (std::size_t j = 0; j < longest_.size(); ++j) {
+    if (static_cast<int>(j) == edge || longest_[j] < 0) continue;
+    const VisibleEdge& other = visible.edges[static_cast<std::size_t>(longest_[j])];
+    const Eigen::Vector2d d = other.b_px - other.a_px;
+    const double length = d.norm();
+    if (!(length > 0)) continue;
+    const Eigen::Vector2d od = d / length;
+    if (std::abs(dir.x() * od.y() - dir.y() * od.x()) > max_sin) continue;  // not parallel
+    const Eigen::Vector2d rel = mid - other.a_px;
+    const double along = rel.dot(od), across = std::abs(rel.x() * od.y() - rel.y() * od.x());
+    if (across < reach_px && along > -reach_px && along < length + reach_px) return true;
+  }
+  return false;
+}
+
+void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement,
+                             bool look_through, LineFeature& f) {
   if (!f.reserved) {
     f.result.reserve(options_.window, options_.epic.ransac);
     f.reserved = true;
@@ -77,7 +102,7 @@ void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece,
     return;
   }
   f.visible = true;
-  detector_.detect(window_, piece.side, f.refs, options_.mode, f.result);
+  detector_.detect(window_, piece.side, f.refs, options_.mode, f.result, look_through);
   // Candidates are sorted by support: drop the tail too weak to be a line of this window.
   const int rows = window_.geometry().rows;
   const int need = std::max(options_.epic.ransac.min_support,

@@ -64,6 +64,9 @@ struct EpicResult {
   std::vector<LineCandidate> candidates;  // best support first
   std::vector<int> inliers;             // indices into edgels.edgels
   int ransac_iterations = 0;
+  // detect() let an edgel whose own object-side interval is empty take the cues of the interval
+  // beyond its neighbour (see EpicDetector::detect); update_references reads the same intervals.
+  bool look_through = false;
   bool found() const { return !candidates.empty(); }
   void reserve(const WindowOptions& window, const RansacOptions& ransac);
 };
@@ -79,8 +82,13 @@ class EpicDetector {
   // row the mode over the half-row beyond init_margin_px, then mean and deviation over rows.
   void init_references(const LineWindow& window, ObjectSide side, FeatureReferences& refs);
   // Edgels, cues, likelihoods, good edgels and candidates of `window`. Gradient mode ignores refs.
+  // look_through: where the interval between an edgel and its neighbour is empty (edgels at most
+  // 3 columns apart: a thin border or strip along the edge, narrower than the edge margins), the
+  // edgel's cue on that side is the interval beyond the neighbour, instead of no evidence. For
+  // an edge with no other model edge close and parallel to it (the caller knows the model); two
+  // close parallel edges would otherwise look alike and no longer be told apart.
   void detect(const LineWindow& window, ObjectSide side, const FeatureReferences& refs,
-              EpicMode mode, EpicResult& out);
+              EpicMode mode, EpicResult& out, bool look_through = false);
   // Re-estimates the object-side references from the interval cues of the candidate's inlier
   // edgels (exponential forgetting, sigma floored). No-op with fewer than 3 valid intervals.
   void update_references(const EpicResult& result, const LineCandidate& selected, ObjectSide side,

@@ -32,6 +32,12 @@ struct LineTrackerOptions {
   // window's rows. Without topology validation (later step) this is what rejects a chance
   // alignment of a few edgels; 0.3 keeps a line that is 70% occluded.
   float min_support_ratio = 0.3f;
+  // EPIC's look-through of empty intervals (EpicDetector::detect) for every edge that has no
+  // other visible model edge within parallel_reach_deg of its direction and half a window width
+  // of it (such an edge could be the neighbour a thin strip separates). A contour with a printed
+  // border or a blurred bevel then keeps the contour instead of the border's inner edge.
+  bool look_through = true;
+  double parallel_reach_deg = 10.0;
 };
 
 // State and latest result of one model edge.
@@ -78,7 +84,9 @@ class LineTracker {
   void reset();
 
  private:
-  void detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, LineFeature& f);
+  void detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, bool look_through,
+                  LineFeature& f);
+  bool has_close_parallel(const VisibleModel& visible, int edge) const;
   LineTrackerOptions options_;
   LineWindow window_;
   EpicDetector detector_;
