@@ -55,7 +55,8 @@ struct State {
   }
   void run() {
     window.sample(image, a, b);
-    detector.detect(window, ObjectSide::Left, refs, mode, result);
+    // With look-through, as LineTracker runs an edge without a close parallel one (this one).
+    detector.detect(window, ObjectSide::Left, refs, mode, result, true);
     if (mode != EpicMode::Gradient && result.found())
       detector.update_references(result, result.candidates.front(), ObjectSide::Left, refs);
   }
