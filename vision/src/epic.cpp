@@ -118,13 +118,9 @@ void EpicDetector::likelihoods(EpicResult& out, ObjectSide side, const FeatureRe
   else std::fill(agree_right_.begin(), agree_right_.begin() + ni, 0.0f);
   const float inv_w = 1.0f / (static_cast<float>(cue_count(colour)) * (wl + wr));
   EdgelSet& set = out.edgels;
-  if (!out.look_through) {
-    for (Edgel& e : set.edgels) e.likelihood = (agree_left_[e.left_interval] + agree_right_[e.left_interval + 1]) * inv_w;
-    return;
-  }
   for (int i = 0; i < static_cast<int>(set.edgels.size()); ++i)
-    set.edgels[i].likelihood = (agree_left_[side_interval(set, out.intervals, i, 0, true)] +
-                                agree_right_[side_interval(set, out.intervals, i, 1, true)]) * inv_w;
+    set.edgels[i].likelihood = (agree_left_[side_interval(set, out.intervals, i, 0, out.look_through)] +
+                                agree_right_[side_interval(set, out.intervals, i, 1, out.look_through)]) * inv_w;
 }
 
 void EpicDetector::select_good_epic(EpicResult& out) const {

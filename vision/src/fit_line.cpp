@@ -133,8 +133,7 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   std::fill(claimed_.begin(), claimed_.begin() + n, 0);
   // The points within tol of a line into scratch_: WindowLine::distance with its root taken
   // once per line instead of once per point (the same operations, so the same decisions), four
-  // points per SSE pass and their indices written from the compare mask.
-  int found = 0;
+  // points per SSE pass and their indices written from the compare mask. Returns their count.
   auto collect_inliers = [&](const WindowLine& line) {
     const float norm = std::sqrt(1.0f + line.m * line.m);
     int* out = scratch_.data();
@@ -150,18 +149,17 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
 #endif
     for (; k < n; ++k)
       if (std::fabs(x[k] - line.m * s[k] - line.c) / norm <= tol) out[count++] = k;
-    found = count;
+    return count;
   };
   for (const Hypothesis& h : hypotheses_) {
     if (h.support < keep * best) continue;
     WindowLine line = h.line;
     for (int pass = 0; pass < 2; ++pass) {
-      collect_inliers(line);
+      const int found = collect_inliers(line);
       if (found < 2) break;
       line = fit_line_tls(x, s, scratch_.data(), found);
     }
-    collect_inliers(line);
-    const int support = found;
+    const int support = collect_inliers(line);
     if (support < options_.min_support) continue;
     // Refinement can pull two hypotheses onto one line: keep the first (stronger) one.
     bool duplicate = false;
@@ -171,14 +169,14 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
     // own: two close parallel edges make diagonals that cross both within the inlier band.
     // Hypotheses come strongest first, so this is decided in support order.
     int exclusive = 0;
-    for (int q = 0; q < found; ++q) exclusive += !claimed_[scratch_[q]];
+    for (int q = 0; q < support; ++q) exclusive += !claimed_[scratch_[q]];
     if (exclusive < keep * best || exclusive < options_.min_support) continue;
-    for (int q = 0; q < found; ++q) claimed_[scratch_[q]] = 1;
+    for (int q = 0; q < support; ++q) claimed_[scratch_[q]] = 1;
     LineFit fit;
     fit.line = line;
     fit.support = support;
     fit.inlier_begin = static_cast<int>(inliers_.size());
-    inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.begin() + found);
+    inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.begin() + support);
     candidates_.push_back(fit);
   }
   // Insertion sort (a handful of candidates; std::stable_sort would allocate a buffer).
