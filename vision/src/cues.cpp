@@ -114,6 +114,29 @@ inline __m128i modal_lanes(__m128i b, __m128i count, __m128i valid, int& top) {
   return _mm_and_si128(_mm_cmpeq_epi8(b, mode), valid);
 }
 
+// Matches at distance 16 + S between hi lane j and lo lane j - S (lanes j >= S), as add_matches.
+template <int S>
+inline void add_cross(__m128i hi, __m128i lo, __m128i& count) {
+  count = _mm_sub_epi8(count, _mm_and_si128(_mm_cmpeq_epi8(hi, _mm_slli_si128(lo, S)), lanes_from(S)));
+}
+
+// modal_lanes() over 32 lanes (lo all valid, hi where valid_hi): the first lane with the top count.
+inline void modal_lanes2(__m128i lo, __m128i hi, __m128i count_lo, __m128i count_hi, __m128i valid_hi, int& top,
+                         __m128i& hit_lo, __m128i& hit_hi) {
+  count_hi = _mm_and_si128(count_hi, valid_hi);
+  // Low byte 31 - lane: lo lanes 31..16, hi lanes 15..0 (the largest key is the first top lane).
+  const __m128i code_lo = _mm_setr_epi8(31, 30, 29, 28, 27, 26, 25, 24, 23, 22, 21, 20, 19, 18, 17, 16);
+  const __m128i code_hi = _mm_setr_epi8(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+  const __m128i key = _mm_max_epu16(_mm_max_epu16(_mm_unpacklo_epi8(code_lo, count_lo), _mm_unpackhi_epi8(code_lo, count_lo)),
+                                    _mm_max_epu16(_mm_unpacklo_epi8(code_hi, count_hi), _mm_unpackhi_epi8(code_hi, count_hi)));
+  const int best = 0xFFFF & ~_mm_cvtsi128_si32(_mm_minpos_epu16(_mm_xor_si128(key, _mm_set1_epi8(-1))));
+  top = best >> 8;
+  const int lane = 31 - (best & 0xFF);
+  const __m128i mode = _mm_shuffle_epi8(lane < 16 ? lo : hi, _mm_set1_epi8(static_cast<char>(lane & 15)));
+  hit_lo = _mm_cmpeq_epi8(lo, mode);
+  hit_hi = _mm_and_si128(_mm_cmpeq_epi8(hi, mode), valid_hi);
+}
+
 }  // namespace
 #endif
 
@@ -166,8 +189,8 @@ void CueHistograms::prepare(const LineWindow& window) {
   if (n > capacity_) {  // first window (or a larger one): warm-up only
     capacity_ = std::max(n, window.options().width_px * window.options().max_rows);
     if (!byte_bins_) bins_.resize(capacity_);
-    // 16 pixels of padding: the short-interval path loads 16 pixels from an interval's start.
-    const std::size_t padded = static_cast<std::size_t>(capacity_) + 16;
+    // 32 pixels of padding: the short-interval paths load 16 or 32 pixels from an interval's start.
+    const std::size_t padded = static_cast<std::size_t>(capacity_) + 32;
     if (byte_bins_) {
       bin8_i_.resize(padded);
       bin8_c_.resize(padded);
@@ -255,6 +278,7 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
 IntervalCues CueHistograms::interval_span(int p0, int p1) {
 #if defined(__SSE4_1__)
   if (byte_bins_ && p1 - p0 <= 16) return interval_short(p0, p1 - p0);
+  if (byte_bins_ && p1 - p0 <= 32) return interval_short2(p0, p1 - p0);
 #endif
   return interval_histogram(p0, p1);
 }
@@ -359,6 +383,8 @@ IntervalCues CueHistograms::interval_short(int p0, int n) const {
   };
   const __m128i b[3] = {load(bin8_i_), load(bin8_c_), load(bin8_t_)};
   __m128i count[3];
+  // Shifts up to 7 or up to 15, not up to n - 1: a stop at each interval's own length is a branch
+  // the predictor misses about once per interval; lanes past n get counts that are masked below.
   prefix_counts(b, n, count, std::make_integer_sequence<int, 15>{});
   const __m128i valid = lanes_below(n);
   int top_i = 0, top_c = 0, top_t = 0;
@@ -394,6 +420,69 @@ IntervalCues CueHistograms::interval_short(int p0, int n) const {
   out.value[1] = s4[1] / static_cast<float>(top_c);
   out.value[2] = s4[2] / static_cast<float>(top_c);
   out.value[3] = s4[3] / static_cast<float>(top_t);
+  out.valid = true;
+  return out;
+}
+
+IntervalCues CueHistograms::interval_short2(int p0, int n) const {
+  // As interval_short() for 16 < n <= 32 pixels in two registers per channel, lo (pixels 0..15)
+  // and hi (16..n-1). lo's prefix counts are its own. A hi lane at distance s from an earlier
+  // pixel finds it, for s <= 15, in the register made of lo's last s lanes and hi's first 16 - s
+  // (PALIGNR), and for s >= 16 in lo shifted by s - 16.
+  auto load = [p0](const std::vector<std::uint8_t>& plane, int at) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(plane.data() + p0 + at));
+  };
+  const __m128i lo[3] = {load(bin8_i_, 0), load(bin8_c_, 0), load(bin8_t_, 0)};
+  const __m128i hi[3] = {load(bin8_i_, 16), load(bin8_c_, 16), load(bin8_t_, 16)};
+  __m128i count_lo[3], count_hi[3];
+  prefix_counts(lo, 16, count_lo, std::make_integer_sequence<int, 15>{});
+  for (__m128i& c : count_hi) c = _mm_set1_epi8(1);
+  [&]<int... S>(std::integer_sequence<int, S...>) {
+    // s = S + 1 = 1..15: every hi lane has its partner at distance s.
+    ((count_hi[0] = _mm_sub_epi8(count_hi[0], _mm_cmpeq_epi8(hi[0], _mm_alignr_epi8(hi[0], lo[0], 15 - S))),
+      count_hi[1] = _mm_sub_epi8(count_hi[1], _mm_cmpeq_epi8(hi[1], _mm_alignr_epi8(hi[1], lo[1], 15 - S))),
+      count_hi[2] = _mm_sub_epi8(count_hi[2], _mm_cmpeq_epi8(hi[2], _mm_alignr_epi8(hi[2], lo[2], 15 - S)))), ...);
+  }(std::make_integer_sequence<int, 15>{});
+  for (int k = 0; k < 3; ++k) count_hi[k] = _mm_sub_epi8(count_hi[k], _mm_cmpeq_epi8(hi[k], lo[k]));  // s = 16
+  // s = 17 + S: hi lane j pairs with lo lane j - 1 - S (lanes j >= 1 + S); stops at s >= n.
+  [&]<int... S>(std::integer_sequence<int, S...>) {
+    (void)((n > S + 17 && (add_cross<S + 1>(hi[0], lo[0], count_hi[0]), add_cross<S + 1>(hi[1], lo[1], count_hi[1]),
+                           add_cross<S + 1>(hi[2], lo[2], count_hi[2]), true)) && ...);
+  }(std::make_integer_sequence<int, 15>{});
+  const __m128i valid_hi = lanes_below(n - 16);
+  int top[3];
+  __m128i hit_lo[3], hit_hi[3];
+  for (int k = 0; k < 3; ++k) modal_lanes2(lo[k], hi[k], count_lo[k], count_hi[k], valid_hi, top[k], hit_lo[k], hit_hi[k]);
+  // The sums in pixel order, as in interval_short(), over both registers' quads.
+  __m128 sum = _mm_setzero_ps();
+  auto add_quads = [&](const __m128i (&hit)[3], int first, int count) {
+    const __m128i ic_lo = _mm_unpacklo_epi8(hit[0], hit[1]), ct_lo = _mm_unpacklo_epi8(hit[1], hit[2]);
+    const __m128i ic_hi = _mm_unpackhi_epi8(hit[0], hit[1]), ct_hi = _mm_unpackhi_epi8(hit[1], hit[2]);
+    const __m128i quads[4] = {_mm_unpacklo_epi16(ic_lo, ct_lo), _mm_unpackhi_epi16(ic_lo, ct_lo),
+                              _mm_unpacklo_epi16(ic_hi, ct_hi), _mm_unpackhi_epi16(ic_hi, ct_hi)};
+    for (int q = 0; 4 * q < count; ++q) {
+      const int p = p0 + first + 4 * q;
+      __m128 v0 = _mm_loadu_ps(planes_[0] + p), v1 = _mm_loadu_ps(planes_[1] + p);
+      __m128 v2 = _mm_loadu_ps(planes_[2] + p), v3 = _mm_loadu_ps(planes_[3] + p);
+      _MM_TRANSPOSE4_PS(v0, v1, v2, v3);
+      auto add = [&](__m128i mask8, __m128 v) {
+        sum = _mm_add_ps(sum, _mm_and_ps(_mm_castsi128_ps(_mm_cvtepi8_epi32(mask8)), v));
+      };
+      add(quads[q], v0);
+      add(_mm_srli_si128(quads[q], 4), v1);
+      add(_mm_srli_si128(quads[q], 8), v2);
+      add(_mm_srli_si128(quads[q], 12), v3);
+    }
+  };
+  add_quads(hit_lo, 0, 16);
+  add_quads(hit_hi, 16, n - 16);
+  alignas(16) float s4[4];
+  _mm_store_ps(s4, sum);
+  IntervalCues out;
+  out.value[0] = s4[0] / static_cast<float>(top[0]);
+  out.value[1] = s4[1] / static_cast<float>(top[1]);
+  out.value[2] = s4[2] / static_cast<float>(top[1]);
+  out.value[3] = s4[3] / static_cast<float>(top[2]);
   out.valid = true;
   return out;
 }

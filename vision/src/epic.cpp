@@ -113,14 +113,21 @@ void EpicDetector::likelihoods(EpicResult& out, ObjectSide side, const FeatureRe
   const float wl = weight_left(side), wr = weight_right(side);
   const int ni = static_cast<int>(out.intervals.size());
   if (wl > 0) cue_agreements(out.intervals.data(), ni, refs.side[0], colour, agree_left_.data());
-  else std::fill(agree_left_.begin(), agree_left_.begin() + ni, 0.0f);
   if (wr > 0) cue_agreements(out.intervals.data(), ni, refs.side[1], colour, agree_right_.data());
-  else std::fill(agree_right_.begin(), agree_right_.begin() + ni, 0.0f);
   const float inv_w = 1.0f / (static_cast<float>(cue_count(colour)) * (wl + wr));
   EdgelSet& set = out.edgels;
-  for (int i = 0; i < static_cast<int>(set.edgels.size()); ++i)
-    set.edgels[i].likelihood = (agree_left_[side_interval(set, out.intervals, i, 0, out.look_through)] +
-                                agree_right_[side_interval(set, out.intervals, i, 1, out.look_through)]) * inv_w;
+  const int n = static_cast<int>(set.edgels.size());
+  auto agreement = [&](const std::vector<float>& agree, int i, int k) {
+    return agree[static_cast<std::size_t>(side_interval(set, out.intervals, i, k, out.look_through))];
+  };
+  // A side of weight 0 adds exactly 0 (agreements are finite and >= 0), so a one-sided edge,
+  // the common case, looks up only its object side.
+  if (wl > 0 && wr > 0)
+    for (int i = 0; i < n; ++i) set.edgels[i].likelihood = (agreement(agree_left_, i, 0) + agreement(agree_right_, i, 1)) * inv_w;
+  else if (wl > 0)
+    for (int i = 0; i < n; ++i) set.edgels[i].likelihood = agreement(agree_left_, i, 0) * inv_w;
+  else
+    for (int i = 0; i < n; ++i) set.edgels[i].likelihood = agreement(agree_right_, i, 1) * inv_w;
 }
 
 void EpicDetector::select_good_epic(EpicResult& out) const {

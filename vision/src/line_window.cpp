@@ -111,37 +111,46 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
     // register each, four all-channel taps, then a 4x4 transpose into the four planes
     // (the same arithmetic as the scalar tap, so the same values).
     {
+      // Two passes over the row: first every column's offset and fractions (vector arithmetic
+      // only), then the taps, whose loads then wait on nothing but these small arrays. In one pass
+      // each tap's loads sit at the end of the coordinate chain and the taps cannot overlap.
       const __m128 vx0 = _mm_set1_ps(x0), vy0 = _mm_set1_ps(y0);
       const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
       const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
       const __m128i vw = _mm_set1_epi32(w);
-      alignas(16) std::int32_t off[4];
+      alignas(16) std::int32_t off[kMaxWindowWidth];
+      alignas(16) float fxs[kMaxWindowWidth], fys[kMaxWindowWidth];
+      const int groups = g.cols / 4 * 4;
       // Column numbers as floats, stepped by 4 (exact: small integers).
       __m128 vc = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f);
       const __m128 four = _mm_set1_ps(4.0f);
-      for (; c + 4 <= g.cols; c += 4, vc = _mm_add_ps(vc, four)) {
+      for (int q = 0; q < groups; q += 4, vc = _mm_add_ps(vc, four)) {
         __m128 x = _mm_add_ps(vx0, _mm_mul_ps(vc, vax)), y = _mm_add_ps(vy0, _mm_mul_ps(vc, vay));
         if (!inside) {
           x = _mm_min_ps(_mm_max_ps(x, zero), vxmax);
           y = _mm_min_ps(_mm_max_ps(y, zero), vymax);
         }
         const __m128i ix = _mm_cvttps_epi32(x), iy = _mm_cvttps_epi32(y);
-        const __m128 fx = _mm_sub_ps(x, _mm_cvtepi32_ps(ix)), fy = _mm_sub_ps(y, _mm_cvtepi32_ps(iy));
-        _mm_store_si128(reinterpret_cast<__m128i*>(off), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
+        _mm_store_ps(fxs + q, _mm_sub_ps(x, _mm_cvtepi32_ps(ix)));
+        _mm_store_ps(fys + q, _mm_sub_ps(y, _mm_cvtepi32_ps(iy)));
+        _mm_store_si128(reinterpret_cast<__m128i*>(off + q), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
+      }
+      for (; c < groups; c += 4) {
         __m128 v[4];
-        auto lerp = [&](int k, __m128 vfx, __m128 vfy) {
-          const float* q0 = px + off[k];
+        auto lerp = [&](int k) {
+          const float* q0 = px + off[c + k];
           const float* q1 = q0 + stride;
+          const __m128 vfx = _mm_load1_ps(fxs + c + k), vfy = _mm_load1_ps(fys + c + k);
           const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
           const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
           const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
           const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
           v[k] = _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top)));
         };
-        lerp(0, _mm_shuffle_ps(fx, fx, 0x00), _mm_shuffle_ps(fy, fy, 0x00));
-        lerp(1, _mm_shuffle_ps(fx, fx, 0x55), _mm_shuffle_ps(fy, fy, 0x55));
-        lerp(2, _mm_shuffle_ps(fx, fx, 0xAA), _mm_shuffle_ps(fy, fy, 0xAA));
-        lerp(3, _mm_shuffle_ps(fx, fx, 0xFF), _mm_shuffle_ps(fy, fy, 0xFF));
+        lerp(0);
+        lerp(1);
+        lerp(2);
+        lerp(3);
         _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
         _mm_storeu_ps(pi + base + c, v[0]);
         _mm_storeu_ps(pr + base + c, v[1]);

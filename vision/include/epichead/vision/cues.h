@@ -74,8 +74,9 @@ class CueHistograms {
   // does not fit a byte (chroma_bins > 16); else the byte planes below hold the bins.
   std::vector<std::uint64_t> bins_;
   // The bins as one byte per pixel and channel (intensity, 2-D chroma, texture), padded by
-  // 16 bytes: an interval of up to 16 pixels is one register per channel and its mode is found
-  // without a histogram (interval_short); longer ones run the histogram loop over these bytes.
+  // 32 bytes: an interval of up to 16 pixels is one register per channel and its mode is found
+  // without a histogram (interval_short), up to 32 two registers (interval_short2); longer
+  // ones run the histogram loop over these bytes.
   bool byte_bins_ = false;
   std::vector<std::uint8_t> bin8_i_, bin8_c_, bin8_t_;
   // The planes of the window given to prepare() (I, R, G, T): the modal-bin sums read them.
@@ -86,6 +87,7 @@ class CueHistograms {
   IntervalCues interval_span(int p0, int p1);       // pixels [p0, p1) of one row, p1 > p0
   IntervalCues interval_histogram(int p0, int p1);  // any length: counts, mode, modal sums
   IntervalCues interval_short(int p0, int n) const; // n <= 16 with byte bins, SSE4.1, same result
+  IntervalCues interval_short2(int p0, int n) const; // 16 < n <= 32, two registers per channel
 };
 
 }  // namespace epichead::vision
