@@ -383,8 +383,6 @@ IntervalCues CueHistograms::interval_short(int p0, int n) const {
   };
   const __m128i b[3] = {load(bin8_i_), load(bin8_c_), load(bin8_t_)};
   __m128i count[3];
-  // Shifts up to 7 or up to 15, not up to n - 1: a stop at each interval's own length is a branch
-  // the predictor misses about once per interval; lanes past n get counts that are masked below.
   prefix_counts(b, n, count, std::make_integer_sequence<int, 15>{});
   const __m128i valid = lanes_below(n);
   int top_i = 0, top_c = 0, top_t = 0;
