@@ -137,6 +137,38 @@ inline void modal_lanes2(__m128i lo, __m128i hi, __m128i count_lo, __m128i count
   hit_hi = _mm_and_si128(_mm_cmpeq_epi8(hi, mode), valid_hi);
 }
 
+// Per pixel a 4-byte mask (I, R, G, T) = (hit_i, hit_c, hit_c, hit_t), four pixels per register.
+inline void masks_by_pixel(__m128i hit_i, __m128i hit_c, __m128i hit_t, __m128i (&quads)[4]) {
+  const __m128i ic_lo = _mm_unpacklo_epi8(hit_i, hit_c), ct_lo = _mm_unpacklo_epi8(hit_c, hit_t);
+  const __m128i ic_hi = _mm_unpackhi_epi8(hit_i, hit_c), ct_hi = _mm_unpackhi_epi8(hit_c, hit_t);
+  quads[0] = _mm_unpacklo_epi16(ic_lo, ct_lo);
+  quads[1] = _mm_unpackhi_epi16(ic_lo, ct_lo);
+  quads[2] = _mm_unpacklo_epi16(ic_hi, ct_hi);
+  quads[3] = _mm_unpackhi_epi16(ic_hi, ct_hi);
+}
+
+// Adds the masked (I, R, G, T) of pixels p .. p + count - 1 (count <= 16) to sum in one add
+// chain in pixel order, as interval_histogram() sums; lanes past count add +0. Four pixels of
+// the four planes are transposed to four (I, R, G, T) vectors (the planes are padded, so the
+// loads past the row's end stay inside them).
+inline __m128 add_modal_sums(const std::array<const float*, kCueChannels>& planes, int p, int count,
+                             const __m128i (&quads)[4], __m128 sum) {
+  auto add = [&](__m128i mask8, __m128 v) {
+    sum = _mm_add_ps(sum, _mm_and_ps(_mm_castsi128_ps(_mm_cvtepi8_epi32(mask8)), v));
+  };
+  for (int q = 0; 4 * q < count; ++q) {
+    const int at = p + 4 * q;
+    __m128 v0 = _mm_loadu_ps(planes[0] + at), v1 = _mm_loadu_ps(planes[1] + at);
+    __m128 v2 = _mm_loadu_ps(planes[2] + at), v3 = _mm_loadu_ps(planes[3] + at);
+    _MM_TRANSPOSE4_PS(v0, v1, v2, v3);  // v_k: pixel at + k
+    add(quads[q], v0);
+    add(_mm_srli_si128(quads[q], 4), v1);
+    add(_mm_srli_si128(quads[q], 8), v2);
+    add(_mm_srli_si128(quads[q], 12), v3);
+  }
+  return sum;
+}
+
 }  // namespace
 #endif
 
@@ -389,28 +421,9 @@ IntervalCues CueHistograms::interval_short(int p0, int n) const {
   const __m128i hit_i = modal_lanes(b[0], count[0], valid, top_i);
   const __m128i hit_c = modal_lanes(b[1], count[1], valid, top_c);
   const __m128i hit_t = modal_lanes(b[2], count[2], valid, top_t);
-  // Per pixel a 4-byte mask (I, R, G, T) = (hit_i, hit_c, hit_c, hit_t), four pixels per register.
-  const __m128i ic_lo = _mm_unpacklo_epi8(hit_i, hit_c), ct_lo = _mm_unpacklo_epi8(hit_c, hit_t);
-  const __m128i ic_hi = _mm_unpackhi_epi8(hit_i, hit_c), ct_hi = _mm_unpackhi_epi8(hit_c, hit_t);
-  const __m128i quads[4] = {_mm_unpacklo_epi16(ic_lo, ct_lo), _mm_unpackhi_epi16(ic_lo, ct_lo),
-                            _mm_unpacklo_epi16(ic_hi, ct_hi), _mm_unpackhi_epi16(ic_hi, ct_hi)};
-  // One add chain in pixel order, as in interval_histogram(); the lanes past n add +0. Four
-  // pixels of the four planes are transposed to four (I, R, G, T) vectors (the planes are
-  // padded, so the loads past the row's end stay inside them).
-  __m128 sum = _mm_setzero_ps();
-  auto add = [&](__m128i mask8, __m128 v) {
-    sum = _mm_add_ps(sum, _mm_and_ps(_mm_castsi128_ps(_mm_cvtepi8_epi32(mask8)), v));
-  };
-  for (int q = 0; 4 * q < n; ++q) {
-    const int p = p0 + 4 * q;
-    __m128 v0 = _mm_loadu_ps(planes_[0] + p), v1 = _mm_loadu_ps(planes_[1] + p);
-    __m128 v2 = _mm_loadu_ps(planes_[2] + p), v3 = _mm_loadu_ps(planes_[3] + p);
-    _MM_TRANSPOSE4_PS(v0, v1, v2, v3);  // v_k: pixel p + k
-    add(quads[q], v0);
-    add(_mm_srli_si128(quads[q], 4), v1);
-    add(_mm_srli_si128(quads[q], 8), v2);
-    add(_mm_srli_si128(quads[q], 12), v3);
-  }
+  __m128i quads[4];
+  masks_by_pixel(hit_i, hit_c, hit_t, quads);
+  const __m128 sum = add_modal_sums(planes_, p0, n, quads, _mm_setzero_ps());
   alignas(16) float s4[4];
   _mm_store_ps(s4, sum);
   IntervalCues out;
@@ -451,29 +464,11 @@ IntervalCues CueHistograms::interval_short2(int p0, int n) const {
   int top[3];
   __m128i hit_lo[3], hit_hi[3];
   for (int k = 0; k < 3; ++k) modal_lanes2(lo[k], hi[k], count_lo[k], count_hi[k], valid_hi, top[k], hit_lo[k], hit_hi[k]);
-  // The sums in pixel order, as in interval_short(), over both registers' quads.
-  __m128 sum = _mm_setzero_ps();
-  auto add_quads = [&](const __m128i (&hit)[3], int first, int count) {
-    const __m128i ic_lo = _mm_unpacklo_epi8(hit[0], hit[1]), ct_lo = _mm_unpacklo_epi8(hit[1], hit[2]);
-    const __m128i ic_hi = _mm_unpackhi_epi8(hit[0], hit[1]), ct_hi = _mm_unpackhi_epi8(hit[1], hit[2]);
-    const __m128i quads[4] = {_mm_unpacklo_epi16(ic_lo, ct_lo), _mm_unpackhi_epi16(ic_lo, ct_lo),
-                              _mm_unpacklo_epi16(ic_hi, ct_hi), _mm_unpackhi_epi16(ic_hi, ct_hi)};
-    for (int q = 0; 4 * q < count; ++q) {
-      const int p = p0 + first + 4 * q;
-      __m128 v0 = _mm_loadu_ps(planes_[0] + p), v1 = _mm_loadu_ps(planes_[1] + p);
-      __m128 v2 = _mm_loadu_ps(planes_[2] + p), v3 = _mm_loadu_ps(planes_[3] + p);
-      _MM_TRANSPOSE4_PS(v0, v1, v2, v3);
-      auto add = [&](__m128i mask8, __m128 v) {
-        sum = _mm_add_ps(sum, _mm_and_ps(_mm_castsi128_ps(_mm_cvtepi8_epi32(mask8)), v));
-      };
-      add(quads[q], v0);
-      add(_mm_srli_si128(quads[q], 4), v1);
-      add(_mm_srli_si128(quads[q], 8), v2);
-      add(_mm_srli_si128(quads[q], 12), v3);
-    }
-  };
-  add_quads(hit_lo, 0, 16);
-  add_quads(hit_hi, 16, n - 16);
+  // The sums in pixel order, as in interval_short(), over both registers' pixels.
+  __m128i quads_lo[4], quads_hi[4];
+  masks_by_pixel(hit_lo[0], hit_lo[1], hit_lo[2], quads_lo);
+  masks_by_pixel(hit_hi[0], hit_hi[1], hit_hi[2], quads_hi);
+  const __m128 sum = add_modal_sums(planes_, p0 + 16, n - 16, quads_hi, add_modal_sums(planes_, p0, 16, quads_lo, _mm_setzero_ps()));
   alignas(16) float s4[4];
   _mm_store_ps(s4, sum);
   IntervalCues out;
