@@ -90,8 +90,10 @@ template <int S>
 inline void add_matches(__m128i b, __m128i& count) {
   count = _mm_sub_epi8(count, _mm_and_si128(_mm_cmpeq_epi8(b, _mm_slli_si128(b, S)), lanes_from(S)));
 }
+// Forced inline (as interval_span and interval_short below): GCC otherwise outlines part of it,
+// and each interval then pays a call and its three counts through memory.
 template <int... S>
-inline void prefix_counts(const __m128i (&b)[3], int n, __m128i (&count)[3], std::integer_sequence<int, S...>) {
+[[gnu::always_inline]] inline void prefix_counts(const __m128i (&b)[3], int n, __m128i (&count)[3], std::integer_sequence<int, S...>) {
   for (__m128i& c : count) c = _mm_set1_epi8(1);
   // S + 1 = the shift; the fold stops at the first shift >= n (no lane has such a neighbour).
   (void)((n > S + 1 && (add_matches<S + 1>(b[0], count[0]), add_matches<S + 1>(b[1], count[1]),
@@ -307,7 +309,7 @@ IntervalCues CueHistograms::interval(const LineWindow& window, int row, int col_
   return interval_span(p0, p1);
 }
 
-IntervalCues CueHistograms::interval_span(int p0, int p1) {
+[[gnu::always_inline]] inline IntervalCues CueHistograms::interval_span(int p0, int p1) {
 #if defined(__SSE4_1__)
   if (byte_bins_ && p1 - p0 <= 16) return interval_short(p0, p1 - p0);
   if (byte_bins_ && p1 - p0 <= 32) return interval_short2(p0, p1 - p0);
@@ -408,7 +410,7 @@ IntervalCues CueHistograms::interval_histogram(int p0, int p1) {
 }
 
 #if defined(__SSE4_1__)
-IntervalCues CueHistograms::interval_short(int p0, int n) const {
+[[gnu::always_inline]] inline IntervalCues CueHistograms::interval_short(int p0, int n) const {
   // The same modes, tie rule and modal-bin sums as interval_histogram(), for n <= 16 pixels.
   auto load = [p0](const std::vector<std::uint8_t>& plane) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(plane.data() + p0));

@@ -62,13 +62,14 @@ void find_edgels(const LineWindow& window, const EdgelOptions& options, EdgelSet
       const float den = l - 2.0f * a + rr;
       float off = den < 0 ? 0.5f * (l - rr) / den : 0.0f;
       off = std::clamp(off, -0.5f, 0.5f);
-      Edgel e;
+      // Built in place: a copy of the 28-byte struct from the stack reloaded 16 bytes that two
+      // narrower stores had just written (a store-forwarding stall on every edgel).
+      Edgel& e = out.edgels.emplace_back();
       e.col = static_cast<float>(c) + off;
       e.x_px = e.col - x_centre;
       e.s_px = s;
       e.gradient = d[c];
       e.row = r;
-      out.edgels.push_back(e);
     };
     auto is_max = [&](int c) {
       const float a = std::fabs(d[c]);
