@@ -145,46 +145,51 @@ TEST_CASE("bad frames and windows outside the image are handled without crashing
 }
 
 TEST_CASE("every vector path samples exactly what the scalar bilinear tap gives", "[line_window]") {
-  // The SSE path interpolates 4 columns at a time; it must give, bit for bit, the documented
-  // scalar tap (x lerp on both rows, then y lerp) at the float coordinates x0 + c * across, so
-  // that tracking results do not depend on the instruction set the build targets.
+  // The SSE and AVX2 paths interpolate 4 columns at a time; they must give, bit for bit, the
+  // documented scalar tap (x lerp on both rows, then y lerp) at the float coordinates
+  // x0 + c * across, so that tracking results do not depend on the instruction set.
   cv::Mat img(90, 120, CV_8UC3);
   cv::RNG rng(5);
   rng.fill(img, cv::RNG::UNIFORM, 0, 256);
   const WindowImage wi = to_window_image(img);
   const int w = wi.width_px(), h = wi.height_px();
   const float* px = wi.pixels();
-  LineWindow win;
-  const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> lines = {
-      {{59.0, 20.0}, {59.0, 60.0}},    // vertical
-      {{30.3, 40.7}, {95.2, 61.1}},    // slanted, inside
-      {{3.0, 5.0}, {110.0, 88.0}},     // corners outside the image: clamped taps
-      {{100.5, 10.25}, {20.75, 70.5}}, // right to left
-  };
-  for (const auto& [a, b] : lines) {
-    REQUIRE(win.sample(wi, a, b));
-    const auto& g = win.geometry();
-    const float ax = static_cast<float>(g.across.x()), ay = static_cast<float>(g.across.y());
-    const float xmax = static_cast<float>(w - 1) - 1e-3f, ymax = static_cast<float>(h - 1) - 1e-3f;
-    int mismatches = 0;
-    for (int r = 0; r < g.rows; ++r) {
-      const Eigen::Vector2d p0 = g.to_image(g.x_of_col(0), g.s_of_row(r));
-      const float x0 = static_cast<float>(p0.x()), y0 = static_cast<float>(p0.y());
-      for (int c = 0; c < g.cols; ++c) {
-        const float x = std::clamp(x0 + static_cast<float>(c) * ax, 0.0f, xmax);
-        const float y = std::clamp(y0 + static_cast<float>(c) * ay, 0.0f, ymax);
-        const int ix = static_cast<int>(x), iy = static_cast<int>(y);
-        const float fx = x - static_cast<float>(ix), fy = y - static_cast<float>(iy);
-        const float* q0 = px + 4 * (static_cast<std::size_t>(iy) * w + ix);
-        const float* q1 = q0 + 4 * static_cast<std::size_t>(w);
-        for (int k = 0; k < 4; ++k) {
-          const float top = q0[k] + fx * (q0[4 + k] - q0[k]), bottom = q1[k] + fx * (q1[4 + k] - q1[k]);
-          const float want = top + fy * (bottom - top);
-          mismatches += win.plane(static_cast<CueChannel>(k))[r * g.cols + c] != want;
+  // Both the SSE path and, where the CPU has it, the AVX2 one.
+  for (const bool avx2 : {false, true}) {
+    WindowOptions options;
+    options.allow_avx2 = avx2;
+    LineWindow win(options);
+    const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> lines = {
+        {{59.0, 20.0}, {59.0, 60.0}},    // vertical
+        {{30.3, 40.7}, {95.2, 61.1}},    // slanted, inside
+        {{3.0, 5.0}, {110.0, 88.0}},     // corners outside the image: clamped taps
+        {{100.5, 10.25}, {20.75, 70.5}}, // right to left
+    };
+    for (const auto& [a, b] : lines) {
+      REQUIRE(win.sample(wi, a, b));
+      const auto& g = win.geometry();
+      const float ax = static_cast<float>(g.across.x()), ay = static_cast<float>(g.across.y());
+      const float xmax = static_cast<float>(w - 1) - 1e-3f, ymax = static_cast<float>(h - 1) - 1e-3f;
+      int mismatches = 0;
+      for (int r = 0; r < g.rows; ++r) {
+        const Eigen::Vector2d p0 = g.to_image(g.x_of_col(0), g.s_of_row(r));
+        const float x0 = static_cast<float>(p0.x()), y0 = static_cast<float>(p0.y());
+        for (int c = 0; c < g.cols; ++c) {
+          const float x = std::clamp(x0 + static_cast<float>(c) * ax, 0.0f, xmax);
+          const float y = std::clamp(y0 + static_cast<float>(c) * ay, 0.0f, ymax);
+          const int ix = static_cast<int>(x), iy = static_cast<int>(y);
+          const float fx = x - static_cast<float>(ix), fy = y - static_cast<float>(iy);
+          const float* q0 = px + 4 * (static_cast<std::size_t>(iy) * w + ix);
+          const float* q1 = q0 + 4 * static_cast<std::size_t>(w);
+          for (int k = 0; k < 4; ++k) {
+            const float top = q0[k] + fx * (q0[4 + k] - q0[k]), bottom = q1[k] + fx * (q1[4 + k] - q1[k]);
+            const float want = top + fy * (bottom - top);
+            mismatches += win.plane(static_cast<CueChannel>(k))[r * g.cols + c] != want;
+          }
         }
       }
+      INFO("line " << a.transpose() << " -> " << b.transpose() << (avx2 ? ", AVX2 allowed" : ", SSE"));
+      CHECK(mismatches == 0);
     }
-    INFO("line " << a.transpose() << " -> " << b.transpose());
-    CHECK(mismatches == 0);
   }
 }

@@ -11,6 +11,51 @@
 
 namespace epichead::vision {
 
+namespace {
+
+#if defined(__SSE4_1__) && defined(__GNUC__) && defined(__x86_64__)
+#define EPICHEAD_WARP_AVX2 1
+// Two 4-float vectors (one pixel's channels each) in the halves of one register.
+__attribute__((target("avx2"))) inline __m256 pair_of(const float* lo, const float* hi) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1);
+}
+// f[0] in the low half's four lanes, f[1] in the high half's.
+__attribute__((target("avx2"))) inline __m256 spread_of(const float* f) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(f)), _mm_broadcast_ss(f + 1), 1);
+}
+// The second pass of a row (see sample()), two taps per 256-bit register where the CPU has AVX2
+// (the build targets x86-64-v2): the same operations per lane in the same order, so the same
+// values, with half the vector arithmetic, which bounds this pass. No FMA: a fused multiply-add
+// would round differently.
+__attribute__((target("avx2"))) void row_taps_avx2(const float* px, std::size_t stride, const std::int32_t* off,
+                                                   const float* fxs, const float* fys, int groups, float* pi,
+                                                   float* pr, float* pg, float* pt) {
+  for (int c = 0; c < groups; c += 4) {
+    __m128 v[4];
+    for (int k = 0; k < 4; k += 2) {
+      const float* q0 = px + off[c + k];
+      const float* r0 = px + off[c + k + 1];
+      const __m256 vfx = spread_of(fxs + c + k), vfy = spread_of(fys + c + k);
+      const __m256 a0 = pair_of(q0, r0), b0 = pair_of(q0 + 4, r0 + 4);
+      const __m256 a1 = pair_of(q0 + stride, r0 + stride), b1 = pair_of(q0 + stride + 4, r0 + stride + 4);
+      const __m256 top = _mm256_add_ps(a0, _mm256_mul_ps(vfx, _mm256_sub_ps(b0, a0)));
+      const __m256 bot = _mm256_add_ps(a1, _mm256_mul_ps(vfx, _mm256_sub_ps(b1, a1)));
+      const __m256 both = _mm256_add_ps(top, _mm256_mul_ps(vfy, _mm256_sub_ps(bot, top)));
+      v[k] = _mm256_castps256_ps128(both);
+      v[k + 1] = _mm256_extractf128_ps(both, 1);
+    }
+    _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
+    _mm_storeu_ps(pi + c, v[0]);
+    _mm_storeu_ps(pr + c, v[1]);
+    _mm_storeu_ps(pg + c, v[2]);
+    _mm_storeu_ps(pt + c, v[3]);
+  }
+}
+const bool kHaveAvx2 = __builtin_cpu_supports("avx2");
+#endif
+
+}  // namespace
+
 RowPlan plan_rows(double length_px, const WindowOptions& options) {
   RowPlan plan;
   if (!std::isfinite(length_px) || length_px < 1.0) return plan;
@@ -135,6 +180,12 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
         _mm_store_ps(fys + q, _mm_sub_ps(y, _mm_cvtepi32_ps(iy)));
         _mm_store_si128(reinterpret_cast<__m128i*>(off + q), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
       }
+#if defined(EPICHEAD_WARP_AVX2)
+      if (kHaveAvx2 && options_.allow_avx2) {
+        row_taps_avx2(px, stride, off, fxs, fys, groups, pi + base, pr + base, pg + base, pt + base);
+        c = groups;
+      }
+#endif
       for (; c < groups; c += 4) {
         __m128 v[4];
         auto lerp = [&](int k) {

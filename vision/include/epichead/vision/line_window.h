@@ -19,6 +19,9 @@ inline constexpr int kMaxWindowWidth = 256;
 struct WindowOptions {
   int width_px = 40;  // samples across the line (the paper's 40 px); 8..kMaxWindowWidth
   int max_rows = 40;  // a line longer than this is sub-sampled by 2^k until rows <= max_rows
+  // Interpolate two pixels per 256-bit register where the CPU has AVX2 (checked at run time; the
+  // build targets x86-64-v2). The values are the same either way; false keeps the SSE path.
+  bool allow_avx2 = true;
 };
 
 // Where a window lies in the image: maps window (column, row) back to image pixels.
