@@ -179,10 +179,11 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     xn_[i] = (x[i] - ox_) * scale_;
     yn_[i] = (y[i] - oy_) * scale_;
   }
-  rng_ = 0x9E3779B9u;
-  auto next = [this] {  // xorshift32: deterministic and cheap
-    rng_ ^= rng_ << 13; rng_ ^= rng_ >> 17; rng_ ^= rng_ << 5;
-    return rng_;
+  // A local state, so that the draws stay in registers (as in LineRansac::fit).
+  std::uint32_t rng = 0x9E3779B9u;
+  auto next = [&rng] {  // xorshift32: deterministic and cheap
+    rng ^= rng << 13; rng ^= rng >> 17; rng ^= rng << 5;
+    return rng;
   };
   const double log_fail = std::log(1.0 - std::clamp(options_.probability, 0.0, 0.999999));
   const double keep = std::clamp(options_.keep_ratio, 0.0, 1.0);

@@ -76,10 +76,13 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   const int max_keep = std::max(1, options_.max_candidates);
   const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
   if (n < std::max(2, options_.min_support)) return 0;
-  rng_ = options_.seed != 0 ? options_.seed : 1u;  // 0 is the one state xorshift cannot leave
-  auto next = [this] {  // xorshift32: deterministic, cheap, good enough for sampling
-    rng_ ^= rng_ << 13; rng_ ^= rng_ >> 17; rng_ ^= rng_ << 5;
-    return rng_;
+  // The generator state and the iteration count live in registers during the loop: as members,
+  // each draw and each iteration went through memory (a store-to-load chain from one hypothesis
+  // to the next).
+  std::uint32_t rng = options_.seed != 0 ? options_.seed : 1u;  // 0 is the one state xorshift cannot leave
+  auto next = [&rng] {  // xorshift32: deterministic, cheap, good enough for sampling
+    rng ^= rng << 13; rng ^= rng >> 17; rng ^= rng << 5;
+    return rng;
   };
   const double log_fail = std::log(1.0 - std::clamp(options_.probability, 0.0, 0.999999));
   const float keep = std::clamp(options_.keep_ratio, 0.0f, 1.0f);
@@ -93,7 +96,8 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   };
   int best = 0;
   int budget = options_.max_iterations;
-  for (; iterations_ < budget; ++iterations_) {
+  int iterations = 0;
+  for (; iterations < budget; ++iterations) {
     const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n));
     int j = static_cast<int>(next() % static_cast<std::uint32_t>(n - 1));
     if (j >= i) ++j;
@@ -127,6 +131,7 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
       if (weakest->support < support) *weakest = {line, support};
     }
   }
+  iterations_ = iterations;
   // Refine each surviving hypothesis: inliers -> TLS -> inliers -> TLS -> final inliers.
   std::sort(hypotheses_.begin(), hypotheses_.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.support > b.support; });
   const float tol = options_.inlier_distance_px;

@@ -70,7 +70,6 @@ class EllipseRansac {
   std::vector<double> xn_, yn_;         // normalised coordinates
   const double* x_ = nullptr;
   const double* y_ = nullptr;
-  std::uint32_t rng_ = 1;
   int iterations_ = 0;
   std::vector<Hypothesis> hypotheses_;
   std::vector<EllipseFit> candidates_;

@@ -67,7 +67,6 @@ class LineRansac {
   RansacOptions options_;
   int max_points_;
   float s_begin_ = 0, s_end_ = 0;
-  std::uint32_t rng_ = 1;
   int iterations_ = 0;
   std::vector<Hypothesis> hypotheses_;
   std::vector<LineFit> candidates_;
