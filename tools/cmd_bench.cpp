@@ -19,6 +19,8 @@ struct BenchResult {
   std::string name;
   double median_us = 0, p99_us = 0, allocs_per_iter = 0;
   long long iterations = 0;
+  int items = 0;  // per iteration (Benchmark::items)
+  double ns_per_item() const { return items > 0 ? median_us * 1000.0 / items : 0.0; }
 };
 
 using Clock = std::chrono::steady_clock;
@@ -52,7 +54,8 @@ BenchResult run_one(const bench::Benchmark& b, double budget_s) {
     const std::size_t i = std::min(samples_us.size() - 1, static_cast<std::size_t>(q * static_cast<double>(samples_us.size())));
     return samples_us[i];
   };
-  return {b.name, quantile(0.5), quantile(0.99), static_cast<double>(allocs) / static_cast<double>(iterations), iterations};
+  return {b.name, quantile(0.5), quantile(0.99), static_cast<double>(allocs) / static_cast<double>(iterations), iterations,
+          b.items};
 }
 
 const CommandRegistration registration{
@@ -62,7 +65,9 @@ const CommandRegistration registration{
       auto filter = std::make_shared<std::string>();
       auto budget_s = std::make_shared<double>(1.0);
       auto list = std::make_shared<bool>(false);
-      app.add_flag("--json", *json, "One JSON object per line: name, median_us, p99_us, allocs_per_iter");
+      app.add_flag("--json", *json,
+                   "One JSON object per line: name, median_us, p99_us, allocs_per_iter, iterations, and "
+                   "ns_per_item for benchmarks with work items (a window's pixels)");
       app.add_option("--time", *budget_s, "Measuring time per benchmark in seconds")->check(CLI::Range(0.01, 60.0));
       app.add_flag("--list", *list, "List the benchmark names and exit");
       app.add_option("filter", *filter, "Run only benchmarks whose name matches this regular expression");
@@ -76,7 +81,8 @@ const CommandRegistration registration{
         auto benchmarks = bench::registry();
         std::sort(benchmarks.begin(), benchmarks.end(), [](auto& a, auto& b) { return a.name < b.name; });
         int ran = 0;
-        if (!*json && !*list) std::printf("%-24s %12s %12s %14s\n", "name", "median_us", "p99_us", "allocs/iter");
+        if (!*json && !*list)
+          std::printf("%-24s %12s %12s %14s %12s\n", "name", "median_us", "p99_us", "allocs/iter", "ns/item");
         for (const auto& b : benchmarks) {
           if (!std::regex_search(b.name, re)) continue;
           ++ran;
@@ -85,9 +91,12 @@ const CommandRegistration registration{
           if (*json) {
             nlohmann::json j{{"name", r.name}, {"median_us", r.median_us}, {"p99_us", r.p99_us},
                              {"allocs_per_iter", r.allocs_per_iter}, {"iterations", r.iterations}};
+            if (r.items > 0) j["ns_per_item"] = r.ns_per_item();
             std::cout << j.dump() << std::endl;
           } else {
-            std::printf("%-24s %12.3f %12.3f %14.3f\n", r.name.c_str(), r.median_us, r.p99_us, r.allocs_per_iter);
+            std::printf("%-24s %12.3f %12.3f %14.3f", r.name.c_str(), r.median_us, r.p99_us, r.allocs_per_iter);
+            if (r.items > 0) std::printf(" %12.3f\n", r.ns_per_item());
+            else std::printf(" %12s\n", "-");
             std::fflush(stdout);
           }
         }

@@ -21,12 +21,17 @@ using Factory = std::function<Iteration()>;
 struct Benchmark {
   std::string name;
   Factory make;
+  // Work items per iteration (for example the pixels of a window), 0 if none: the harness then
+  // also reports the median time per item, in ns.
+  int items = 0;
 };
 
 std::vector<Benchmark>& registry();
 
 struct Registration {
-  Registration(std::string name, Factory make) { registry().push_back({std::move(name), std::move(make)}); }
+  Registration(std::string name, Factory make, int items = 0) {
+    registry().push_back({std::move(name), std::move(make), items});
+  }
 };
 
 // Heap allocations made by this process so far (operator new, all threads).
