@@ -152,13 +152,12 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
     }
 #endif
 #if defined(__SSE4_1__)
-    // Four pixels per pass: the coordinates, floors and fractions of four columns in one
-    // register each, four all-channel taps, then a 4x4 transpose into the four planes
-    // (the same arithmetic as the scalar tap, so the same values).
+    // Two passes over the row, four columns per register. First every column's image offset and
+    // fractions (vector arithmetic only); then four all-channel taps at a time and a 4x4
+    // transpose into the four planes, with the scalar tap's arithmetic (so the same values). The
+    // taps' loads then wait on nothing but these small arrays: in one pass each tap's loads sat
+    // at the end of the coordinate chain and the taps could not overlap.
     {
-      // Two passes over the row: first every column's offset and fractions (vector arithmetic
-      // only), then the taps, whose loads then wait on nothing but these small arrays. In one pass
-      // each tap's loads sit at the end of the coordinate chain and the taps cannot overlap.
       const __m128 vx0 = _mm_set1_ps(x0), vy0 = _mm_set1_ps(y0);
       const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
       const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
