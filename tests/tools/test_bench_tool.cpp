@@ -2,45 +2,23 @@
 // (not how fast anything is: speed is judged from benchmark runs, never by a timed test).
 #include <catch2/catch.hpp>
 
-#include <sys/wait.h>
-
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "common/temp_dir.h"
+#include "common/run_tool.h"
 
 namespace {
+
+using epichead::testing::ToolRun;
 
 struct TempDir : epichead::testing::TempDir {
   TempDir() : epichead::testing::TempDir("epichead_test_bench_tool") {}
 };
 
-struct Run {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Run bench(const TempDir& tmp, const std::string& args) {
-  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  const std::string command = "'" + std::string(EPICHEAD_BIN) + "' bench " + args + " > '" + out + "' 2> '" + err + "'";
-  const int status = std::system(command.c_str());
-  Run r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+ToolRun bench(const TempDir& tmp, const std::string& args) { return epichead::testing::run_epichead(tmp, "bench " + args); }
 
 std::vector<nlohmann::json> json_lines(const std::string& text) {
   std::vector<nlohmann::json> lines;
@@ -54,7 +32,7 @@ std::vector<nlohmann::json> json_lines(const std::string& text) {
 
 TEST_CASE("bench reports the EPIC window per pixel and with no heap allocation per window", "[bench]") {
   TempDir tmp;
-  const Run r = bench(tmp, "--time 0.05 --json '^epic_window$'");
+  const ToolRun r = bench(tmp, "--time 0.05 --json '^epic_window$'");
   REQUIRE(r.exit_code == 0);
   const auto lines = json_lines(r.out);
   REQUIRE(lines.size() == 1);
@@ -71,7 +49,7 @@ TEST_CASE("bench reports the EPIC window per pixel and with no heap allocation p
 
 TEST_CASE("bench's table has the per-item column, '-' where a benchmark has no items", "[bench]") {
   TempDir tmp;
-  const Run r = bench(tmp, "--time 0.02 '^epic_window$|^imu_step$'");
+  const ToolRun r = bench(tmp, "--time 0.02 '^epic_window$|^imu_step$'");
   REQUIRE(r.exit_code == 0);
   std::istringstream in(r.out);
   std::string header;
@@ -91,10 +69,10 @@ TEST_CASE("bench's table has the per-item column, '-' where a benchmark has no i
 
 TEST_CASE("bench refuses a bad filter and a filter that matches nothing", "[bench]") {
   TempDir tmp;
-  const Run bad = bench(tmp, "'('");
+  const ToolRun bad = bench(tmp, "'('");
   CHECK(bad.exit_code != 0);
   CHECK(bad.err.find("regular expression") != std::string::npos);
-  const Run none = bench(tmp, "'^no_such_benchmark$'");
+  const ToolRun none = bench(tmp, "'^no_such_benchmark$'");
   CHECK(none.exit_code != 0);
   CHECK(none.err.find("no benchmark matches") != std::string::npos);
 }

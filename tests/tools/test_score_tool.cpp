@@ -16,7 +16,7 @@
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
 #include "epichead/vision/visibility.h"
-#include "common/temp_dir.h"
+#include "common/run_tool.h"
 
 using namespace epichead::vision;
 
@@ -28,29 +28,11 @@ struct TempDir : epichead::testing::TempDir {
   TempDir() : epichead::testing::TempDir("epichead_test_score_tool") {}
 };
 
-struct Run {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using epichead::testing::slurp;
+using Run = epichead::testing::ToolRun;
 
 // Runs `epichead score <args>` (arguments already shell-quoted) and captures both streams.
-Run score(const TempDir& tmp, const std::string& args) {
-  const std::string out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  const std::string command = "'" + std::string(EPICHEAD_BIN) + "' score " + args + " > '" + out + "' 2> '" + err + "'";
-  const int status = std::system(command.c_str());
-  Run r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+Run score(const TempDir& tmp, const std::string& args) { return epichead::testing::run_epichead(tmp, "score " + args); }
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
 
