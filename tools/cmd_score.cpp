@@ -79,6 +79,7 @@ void print_human(const std::string& seq_dir, const ScoreSummary& s, int ignored)
   std::printf("sequence         %s\n", seq_dir.c_str());
   std::printf("frames           %d (with an estimate: %d, succeeded: %d)\n", s.frames, s.present, s.succeeded);
   std::printf("success rate     %.1f %% (within 50 mm and 5 deg)\n", 100.0 * s.success_rate);
+  std::printf("tight success    %.1f %% (within 20 mm and 2 deg)\n", 100.0 * s.success_rate_tight);
   std::printf("losses           %d\n", s.losses);
   if (ignored > 0) std::printf("ignored          %d estimates for frames without ground truth\n", ignored);
   std::printf("%-16s %10s %10s %10s\n", "", "mean", "median", "p95");
@@ -104,7 +105,7 @@ const CommandRegistration registration{
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
-                   "Print one JSON object: frames, present, succeeded, success_rate, losses, "
+                   "Print one JSON object: frames, present, succeeded, success_rate, success_rate_2cm_2deg, losses, "
                    "rotation_deg/translation_mm/reprojection_px {mean, median, p95}");
       app.add_option("--sym-axis", *axis_text,
                      "X,Y,Z: the object is symmetric about this axis through its origin (object frame); "
@@ -200,6 +201,8 @@ const CommandRegistration registration{
                                  {"present", summary.present},
                                  {"succeeded", summary.succeeded},
                                  {"success_rate", summary.success_rate},
+                                 {"succeeded_2cm_2deg", summary.succeeded_tight},
+                                 {"success_rate_2cm_2deg", summary.success_rate_tight},
                                  {"losses", summary.losses},
                                  {"ignored", ignored},
                                  {"rotation_deg", stats_json(summary.rotation_deg)},

@@ -41,6 +41,7 @@ struct TrackArgs {
   double crease_deg = 20.0;
   double max_view_deg = 85.0;
   std::string imu_time_offset = "auto";
+  std::string free_turn = "auto";
   std::uint32_t ransac_seed = RansacOptions{}.seed;
 };
 
@@ -154,6 +155,8 @@ int run_track(const TrackArgs& args) {
   options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
   options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
   options.lines.epic.ransac.seed = args.ransac_seed;
+  if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
+  options.free_turn_of_revolution = args.free_turn == "auto";
   ModelTracker tracker(seq->model(), seq->camera(), options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
@@ -171,7 +174,7 @@ int run_track(const TrackArgs& args) {
   lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n";
 
   std::vector<StampedPose> poses, vision_poses;
-  int fused_frames = 0;
+  int fused_frames = 0, fallback_frames = 0;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
   int tracked = 0, degraded = 0, lost = 0, overlays = 0;
@@ -183,7 +186,9 @@ int run_track(const TrackArgs& args) {
     if (auto ok = image.assign(*frame); !ok) return fail(cmd, "frame " + std::to_string(i) + ": " + ok.error());
     const FrameEntry& entry = seq->frames()[i];
     const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
-    tracker.track(image, predicted, report);
+    const std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
+    tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
+    fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
     track_ms.push_back(report.times.total_ms);
     tracked += report.status == TrackStatus::Tracked;
@@ -286,7 +291,13 @@ int run_track(const TrackArgs& args) {
   j["track_ms_median"] = percentile(track_ms, 0.5);
   j["track_ms_p99"] = percentile(track_ms, 0.99);
   j["predictor"] = (*predictor)->diagnostics();
-  j["fused_frames"] = fused_frames;  // frames whose poses.csv row is the filter's estimate
+  j["fused_frames"] = fused_frames;
+  j["fallback_frames"] = fallback_frames;  // frames measured from the vision-only extrapolation
+  if (tracker.free_turn()) {
+    const auto& a = *tracker.free_turn();
+    j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
+                           {"direction_obj", {a.direction_obj.x(), a.direction_obj.y(), a.direction_obj.z()}}};
+  }  // frames whose poses.csv row is the filter's estimate
   if (!video_note.empty()) j["video_note"] = video_note;
   j["per_frame"] = std::move(per_frame);
   const std::string report_path = (fs::path(args.out) / "report.json").string();
@@ -325,6 +336,9 @@ const CommandRegistration registration{
       app.add_option("--max-view-deg", a->max_view_deg,
                      "Faces seen more edge-on than this (angle of normal to line of sight) count as turned away (default 85; 90: all front faces)")
           ->check(CLI::Range(0.0, 90.0));
+      app.add_option("--free-turn", a->free_turn,
+                     "auto (default): a model that is a body of revolution (facets and coaxial rims) leaves its turn "
+                     "about the axis to the prediction, and its covariance says so; off: the pose fits all six degrees");
       app.add_option("--ransac-seed", a->ransac_seed,
                      "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");
       return [a]() { return run_track(*a); };

@@ -1,6 +1,8 @@
 #include "track_prediction.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
@@ -57,6 +59,37 @@ class ConstantVelocityPredictor final : public TrackPredictor {
   int lost_ = 0;
 };
 
+// Consistency of the vision updates: the normalised innovation squared (NIS) of a pose against
+// the filter's prediction is chi-square with 6 degrees of freedom when both covariances are
+// honest: mean 6, and 95 % of the values within [1.237, 14.449].
+class NisStats {
+ public:
+  void add(double nis) { if (std::isfinite(nis)) values_.push_back(nis); }
+  nlohmann::json to_json() const {
+    if (values_.empty()) return {{"count", 0}};
+    std::vector<double> v = values_;
+    std::sort(v.begin(), v.end());
+    double sum = 0;
+    int below = 0, above = 0;
+    for (double x : v) {
+      sum += x;
+      below += x < kChi2Low;
+      above += x > kChi2High;
+    }
+    const double n = static_cast<double>(v.size());
+    return {{"count", v.size()},
+            {"mean", sum / n},
+            {"median", v[v.size() / 2]},
+            {"below_chi2_2.5pct", below / n},
+            {"above_chi2_97.5pct", above / n},
+            {"within_95pct_bounds", (n - below - above) / n}};
+  }
+
+ private:
+  static constexpr double kChi2Low = 1.237, kChi2High = 14.449;
+  std::vector<double> values_;
+};
+
 // The Kalman predictor fed with the sequence's imu.csv: before each frame every IMU sample up
 // to the frame's time is propagated; each tracked pose is a vision update at its exposure time.
 // While the object is lost the gyro keeps the orientation, so windows follow a turning camera;
@@ -67,7 +100,8 @@ class ImuPredictor final : public TrackPredictor {
   ImuPredictor(const fusion::PredictorOptions& options, fusion::Predictor predictor, const vision::Sequence& seq,
                std::optional<fusion::TimeOffsetEstimator> estimator)
       : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
-        last_good_(seq.init().cam_T_obj), estimator_(std::move(estimator)) {
+        last_good_(seq.init().cam_T_obj), vision_only_(seq.init().t_s, seq.init().cam_T_obj),
+        estimator_(std::move(estimator)) {
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
     init_t_s_ = seq.init().t_s;
@@ -82,7 +116,9 @@ class ImuPredictor final : public TrackPredictor {
     ++fallbacks_;
     return last_good_;
   }
+  std::optional<Eigen::Isometry3d> fallback(double t_s) override { return vision_only_.predict(t_s); }
   void observe(double t_s, const vision::FrameReport& report) override {
+    vision_only_.observe(t_s, report);
     if (report.status == vision::TrackStatus::Lost) {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
@@ -103,7 +139,21 @@ class ImuPredictor final : public TrackPredictor {
         if (const auto e = estimator_->estimate()) return adopt(*e, t_s, report);
       }
     }
-    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
+    const Matrix6 cov = vision::kTrackedPoseCovarianceInflation * report.covariance;
+    auto r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
+    if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
+    // Vision and the filter disagree: which is wrong? A pose found only from the vision-only
+    // extrapolation says the IMU's prediction had left the object; a run of gated poses that
+    // the image supports well (tracked, not degraded) says the filter has drifted. Either way
+    // the filter restarts from vision now instead of after reinit_after_gated frames.
+    if (r.verdict == fusion::VisionVerdict::Gated && report.status == vision::TrackStatus::Tracked) ++supported_gated_;
+    else supported_gated_ = 0;
+    if (report.used_fallback || supported_gated_ >= kSupportedGatedRestart) {
+      predictor_.reset();
+      r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
+      supported_gated_ = 0;
+      ++(report.used_fallback ? fallback_restarts_ : gated_restarts_);
+    }
     // A tracked pose supersedes the init pose as the filter's seed, whether it started the
     // filter or could not yet (no IMU sample before it, or too old).
     if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld ||
@@ -137,12 +187,17 @@ class ImuPredictor final : public TrackPredictor {
             {"vision_too_old", c.vision_too_old},
             {"reinitialisations", c.reinitialisations},
             {"resets_after_loss", resets_},
+            {"restarts_from_fallback", fallback_restarts_},
+            {"restarts_after_supported_gated", gated_restarts_},
+            {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},
             {"lost_frames", lost_}};
   }
 
  private:
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
   static constexpr double kLostResetS = 1.0;
+  static constexpr int kSupportedGatedRestart = 3;
   static constexpr int kFitEveryFrames = 10;
   void feed_until(double t_s) {
     const auto& imu = *imu_;
@@ -192,6 +247,9 @@ class ImuPredictor final : public TrackPredictor {
   double last_good_t_s_ = 0, init_t_s_ = 0;
   bool pending_init_ = false, reset_done_ = false;
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
+  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0;
+  ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
+  NisStats nis_;
   // Offset estimation (auto).
   static constexpr double kEstimatorLeadS = 0.15;
   std::optional<fusion::TimeOffsetEstimator> estimator_;

@@ -26,6 +26,9 @@ class TrackPredictor {
   // weighed against the IMU's propagation, or the propagation alone when the pose was gated
   // out), or nothing when the predictor only extrapolates the vision poses.
   virtual std::optional<Eigen::Isometry3d> fused(double t_s) = 0;
+  // A second opinion for a frame the tracker loses from predict(t_s): the vision poses
+  // extrapolated alone, when the predictor is more than that (the IMU); nothing otherwise.
+  virtual std::optional<Eigen::Isometry3d> fallback(double t_s) { (void)t_s; return std::nullopt; }
   // Counters for report.json.
   virtual nlohmann::json diagnostics() const = 0;
 };

@@ -138,6 +138,8 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
   if (placement == WindowPlacement::Previous && f.has_previous) {
     on = f.ellipse;
     arc = f.arc;
+  } else if (placement == WindowPlacement::ProjectionOnArc && f.has_previous) {
+    arc = f.arc;  // polar angles about the centre: they carry over to the projection
   }
   if (!place(image, f, on, arc)) {
     f.has_previous = false;

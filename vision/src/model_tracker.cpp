@@ -89,6 +89,7 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
     obs.edgels_px.reserve(static_cast<std::size_t>(options.lines.window.max_rows) * 4);
   }
   problem_.points.reserve(model.vertices.size());
+  if (options.free_turn_of_revolution) problem_.free_turn = find_revolution_axis(model);
   // One slot per model circle, like the lines (a slot without points is ignored).
   problem_.ellipses.resize(model.circles.size());
   for (std::size_t c = 0; c < model.circles.size(); ++c) {
@@ -110,6 +111,7 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
 void ModelTracker::reset() {
   lines_.reset();
   ellipses_.reset();
+  settled_ = false;
   std::fill(kept_last_.begin(), kept_last_.end(), kNotVisible);
   was_lost_ = false;
 }
@@ -171,7 +173,7 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
   for (EllipseObservation& obs : problem_.ellipses) obs.points_px.clear();
   if (!visible_.ellipses.empty()) {
     t = Clock::now();
-    ellipses_.track(image, visible_, WindowPlacement::Projection);
+    ellipses_.track(image, visible_, WindowPlacement::ProjectionOnArc);
     for (const EllipseFeature& f : ellipses_.features()) {
       out.ellipses_visible += f.visible;
       if (!f.visible || !f.found || f.circle < 0 || f.circle >= static_cast<int>(problem_.ellipses.size())) continue;
@@ -261,16 +263,79 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
   return pose_ok;
 }
 
+void ModelTracker::set_mode(TrackMode mode) {
+  options_.mode = mode;
+  lines_.set_mode(epic_mode(mode));
+  ellipses_.set_mode(epic_mode(mode));
+}
+
+Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times) {
+  // How well the image supports a measurement: the share of found features the pose keeps.
+  const auto support = [](const FrameReport& r) {
+    return static_cast<double>(r.inliers + 2 * r.ellipses_found) / std::max(1, r.found + 2 * r.ellipses_found);
+  };
+  const auto add_times = [&times](const FrameReport& r) {
+    times.visibility_ms += r.times.visibility_ms;
+    times.epic_ms += r.times.epic_ms;
+    times.validation_ms += r.times.validation_ms;
+    times.pose_ms += r.times.pose_ms;
+  };
+  const TrackMode mode = options_.mode;
+  if (mode == TrackMode::Gradient) return predicted;  // gradient needs no references
+  FrameReport direct, gradient, refined;
+  const bool direct_ok = measure(image, predicted, direct);
+  set_mode(TrackMode::Gradient);
+  const bool gradient_ok = measure(image, predicted, gradient);
+  set_mode(mode);
+  add_times(direct);
+  add_times(gradient);
+  if (!gradient_ok) return predicted;
+  // References afresh from the gradient pose's projection.
+  lines_.reset();
+  ellipses_.reset();
+  const bool refined_ok = measure(image, gradient.cam_T_obj, refined);
+  add_times(refined);
+  if (refined_ok && (!direct_ok || support(refined) >= support(direct))) return gradient.cam_T_obj;
+  lines_.reset();
+  ellipses_.reset();
+  return predicted;
+}
+
 void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
+  track(image, predicted, nullptr, out);
+}
+
+void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& predicted, const Eigen::Isometry3d* fallback,
+                         FrameReport& out) {
   const auto t_start = Clock::now();
   out = FrameReport{};
   out.cam_T_obj = predicted;
-  const bool pose_ok = measure(image, predicted, out);
+  StageTimes settling;
+  const Eigen::Isometry3d start = settled_ ? predicted : settle(image, predicted, settling);
+  bool pose_ok = measure(image, start, out);
+  out.times.visibility_ms += settling.visibility_ms;
+  out.times.epic_ms += settling.epic_ms;
+  out.times.validation_ms += settling.validation_ms;
+  out.times.pose_ms += settling.pose_ms;
+  if (!pose_ok && fallback) {
+    // The second opinion: measured afresh from the other prediction (measure() learns nothing,
+    // so the first attempt leaves no trace but its stage times, which add up).
+    const StageTimes first = out.times;
+    const int iterations = out.pose_iterations;
+    out = FrameReport{};
+    out.cam_T_obj = *fallback;
+    out.times = first;
+    out.pose_iterations = iterations;
+    pose_ok = measure(image, *fallback, out);
+    out.used_fallback = true;
+    if (!pose_ok) out.cam_T_obj = predicted;
+  }
   const auto& features = lines_.features();
   TrackReason reasons = out.reasons;
   if (!pose_ok) {
     out.status = TrackStatus::Lost;
     out.cam_T_obj = predicted;
+    out.used_fallback = false;
     for (const LineFeature& f : features)
       if (f.visible) lines_.reject(f.edge);
     std::fill(kept_now_.begin(), kept_now_.end(), kNotVisible);
@@ -293,6 +358,7 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   }
   out.reasons = reasons;
   was_lost_ = out.status == TrackStatus::Lost;
+  settled_ = !was_lost_;
   std::swap(kept_last_, kept_now_);
   out.times.total_ms = ms_since(t_start);
 }

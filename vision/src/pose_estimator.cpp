@@ -15,7 +15,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Householder>
 #include <Eigen/LU>
+#include <Eigen/QR>
 
 namespace epichead::vision {
 namespace {
@@ -68,6 +70,40 @@ double tukey_rho(double r, double c, double rho_max) {
   if (std::abs(r) >= c) return rho_max;
   const double t = 1 - (r / c) * (r / c);
   return rho_max * (1 - t * t * t);
+}
+
+// The directions a step may take: all six, or the five orthogonal to a body of revolution's
+// turn (its twist at the pose, unit length). Any complement of the turn reaches the same
+// poses up to that turn; the orthogonal one keeps the solve well conditioned.
+struct StepBasis {
+  Eigen::Matrix<double, 6, 6> B = Eigen::Matrix<double, 6, 6>::Identity();  // first `dims` columns used
+  Vector6d turn = Vector6d::Zero();  // the free turn's twist (rotation part unit), or zero
+  int dims = 6;
+};
+
+StepBasis step_basis(const PoseProblem& problem, const Eigen::Isometry3d& pose) {
+  StepBasis b;
+  if (!problem.free_turn) return b;
+  b.turn = revolution_twist(*problem.free_turn, pose);
+  if (!b.turn.allFinite()) return StepBasis{};
+  // Householder: Q's first column is along the turn, the other five span its complement.
+  const Eigen::Matrix<double, 6, 6> Q = Eigen::HouseholderQR<Vector6d>(b.turn.normalized()).householderQ();
+  b.B.leftCols<5>() = Q.rightCols<5>();
+  b.dims = 5;
+  return b;
+}
+
+// Solves (H + lambda diag(H)) step = -g within the basis's directions.
+Vector6d damped_step(const StepBasis& b, const Matrix6d& H, const Vector6d& g, double lambda) {
+  if (b.dims == 6) {
+    Matrix6d A = H;
+    A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
+    return -A.ldlt().solve(g);
+  }
+  const Eigen::Matrix<double, 6, 5> B = b.B.leftCols<5>();
+  Eigen::Matrix<double, 5, 5> A = B.transpose() * H * B;
+  A.diagonal() += lambda * A.diagonal().cwiseMax(1e-9);
+  return -B * A.ldlt().solve(B.transpose() * g);
 }
 
 double median_in_place(std::vector<double>& v) {
@@ -363,10 +399,9 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
     };
     bool improved = false;
     Vector6d step = Vector6d::Zero();
+    const StepBasis basis = step_basis(problem, pose);
     for (int tries = 0; tries < 8; ++tries) {
-      Matrix6d A = H;
-      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
-      step = -A.ldlt().solve(g);
+      step = damped_step(basis, H, g, lambda);
       if (!step.allFinite()) break;
       const Eigen::Isometry3d candidate = apply_left(step, pose);
       if (all_in_front(candidate) && weighted_cost(candidate) <= base) {
@@ -412,18 +447,38 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   normal_equations(pose, c, H, unused_g, wr2, wsum, unused_cost);
   out.cam_T_obj = pose;
   out.scale_px = scale;
-  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(H);
+  // Degeneracy and covariance within the directions the features are asked to fix: with a free
+  // turn, H restricted to its complement, and the turn's own variance added along its twist.
+  const StepBasis basis = step_basis(problem, pose);
+  Matrix6d H_fixed = H;
+  if (basis.dims < 6) {
+    // The 5x5 problem padded with its mean eigenvalue: the padding changes neither extreme.
+    const Eigen::Matrix<double, 6, 5> B = basis.B.leftCols<5>();
+    H_fixed.setZero();
+    H_fixed.topLeftCorner<5, 5>() = B.transpose() * H * B;
+    H_fixed(5, 5) = H_fixed.topLeftCorner<5, 5>().trace() / 5;
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(H_fixed);
   const double max_ev = eig.eigenvalues().maxCoeff(), min_ev = eig.eigenvalues().minCoeff();
   if (!(min_ev > 0) || max_ev / min_ev > options_.max_condition) {
     out.status = PoseStatus::Degenerate;
-    const Vector6d weak = eig.eigenvectors().col(0);
+    const Vector6d weak = basis.B * eig.eigenvectors().col(0);
     int axis = 0;
     weak.cwiseAbs().maxCoeff(&axis);
     static const char* names[6] = {"x translation", "y translation", "z translation", "x rotation", "y rotation", "z rotation"};
     out.reason = std::string("features do not constrain the pose; weakest direction mostly ") + names[axis];
   }
-  const double sigma2 = std::max(1.0, wsum > 6 ? wr2 / (wsum - 6) : 1.0);
-  out.covariance = out.status == PoseStatus::Ok ? Matrix6d(sigma2 * H.inverse()) : Matrix6d(Matrix6d::Identity() * 1e6);
+  const double sigma2 = std::max(1.0, wsum > 6 ? wr2 / (wsum - basis.dims) : 1.0);
+  if (out.status != PoseStatus::Ok) {
+    out.covariance = Matrix6d::Identity() * 1e6;
+  } else if (basis.dims == 6) {
+    out.covariance = sigma2 * H.inverse();
+  } else {
+    const Eigen::Matrix<double, 6, 5> B = basis.B.leftCols<5>();
+    const Eigen::Matrix<double, 5, 5> H5 = H_fixed.topLeftCorner<5, 5>();
+    const double s = problem.free_turn_sigma_rad;
+    out.covariance = sigma2 * B * H5.inverse() * B.transpose() + (s * s) * basis.turn * basis.turn.transpose();
+  }
 
   // Per-feature RMS (pixels for image features, metres for 3D points) and inlier flags.
   feature_rms(pose);

@@ -128,17 +128,20 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std
       s.translation_mm = 1000.0 * translation_m;
       s.reprojection_px = reprojection_error_px(points, camera, gt->cam_T_obj, est_T);
       s.success = translation_m <= criterion.max_translation_m && s.rotation_deg <= criterion.max_rotation_deg;
+      s.success_tight = translation_m <= criterion.tight_translation_m && s.rotation_deg <= criterion.tight_rotation_deg;
       ++summary.present;
       rot.push_back(s.rotation_deg);
       trans.push_back(s.translation_mm);
       reproj.push_back(s.reprojection_px);
     }
     if (s.success) ++summary.succeeded;
+    if (s.success_tight) ++summary.succeeded_tight;
     if (!s.success && !in_failure_run) ++summary.losses;
     in_failure_run = !s.success;
     summary.per_frame.push_back(s);
   }
   summary.success_rate = summary.frames > 0 ? static_cast<double>(summary.succeeded) / summary.frames : 0.0;
+  summary.success_rate_tight = summary.frames > 0 ? static_cast<double>(summary.succeeded_tight) / summary.frames : 0.0;
   summary.rotation_deg = stats_of(std::move(rot));
   summary.translation_mm = stats_of(std::move(trans));
   summary.reprojection_px = stats_of(std::move(reproj));

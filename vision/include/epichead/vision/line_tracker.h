@@ -22,6 +22,10 @@ namespace epichead::vision {
 enum class WindowPlacement {
   Previous,    // on the feature's previous result when it was found, else on the projection
   Projection,  // always on the projection (a given or predicted pose)
+  // On the projection, but an ellipse found on an arc last frame (partly occluded) is looked
+  // for on that arc, with the extension lines beyond its ends that see the occluder leave;
+  // lines as Projection. What the full tracker uses.
+  ProjectionOnArc,
 };
 
 struct LineTrackerOptions {

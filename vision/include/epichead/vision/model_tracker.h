@@ -6,6 +6,7 @@
 // covariance, a status with reasons, per-stage timings and feature counts. After warm-up (the
 // first frames, while buffers grow to their working size) a frame allocates nothing.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,10 @@ struct ModelTrackerOptions {
   // degrees of freedom; beyond ~10 edgels more only cost time (the errors of neighbouring
   // edgels of one blurred edge are correlated, so they add little information either).
   int max_edgels_per_line = 10;
+  // A body of revolution modelled by facets (revolution_axis.h): the pose leaves its turn about
+  // the axis to the prediction and its covariance says the turn is unknown. Found from the
+  // model when true; off for every model when false.
+  bool free_turn_of_revolution = true;
 };
 
 // Per-stage wall time of one frame, milliseconds.
@@ -97,6 +102,7 @@ struct FrameReport {
   int inliers = 0, rejected = 0;   // found lines the pose kept / rejected as outliers
   int recovered = 0;               // lines found and kept that were lost or rejected last frame
   int combinations = 0;            // candidate combinations validation examined
+  bool used_fallback = false;      // the pose was measured from the fallback prediction
   StageTimes times;
 };
 
@@ -108,6 +114,11 @@ class ModelTracker {
   // Tracks one frame from the predicted pose (the init pose on the first frame). `out` is
   // reused between frames.
   void track(const WindowImage& image, const Eigen::Isometry3d& predicted_cam_T_obj, FrameReport& out);
+  // The same with a second opinion: when nothing usable is measured from the prediction, the
+  // frame is measured again from `fallback` (e.g. the vision-only extrapolation when the IMU's
+  // prediction has drifted). nullptr: no second attempt.
+  void track(const WindowImage& image, const Eigen::Isometry3d& predicted_cam_T_obj, const Eigen::Isometry3d* fallback,
+             FrameReport& out);
   // Forgets every feature's references and history (re-initialisation).
   void reset();
 
@@ -118,6 +129,8 @@ class ModelTracker {
   const ValidationResult& validation() const { return validation_; }
   const PoseResult& pose() const { return pose_; }
   const VisibleModel& visible() const { return visible_; }
+  // The body of revolution's axis whose turn the pose leaves free, or nothing.
+  const std::optional<RevolutionAxis>& free_turn() const { return problem_.free_turn; }
 
  private:
   void build_problem();
@@ -125,6 +138,14 @@ class ModelTracker {
   // checks; sets the counts and reasons of `out` and adds to its stage times. True when the
   // pose is usable. Learns nothing (references change only in track()).
   bool measure(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out);
+  // The first frame (and the first after a reset or a loss) has cue references only from the
+  // prediction's projection: a start a centimetre off samples them partly beside the object,
+  // and EPIC then prefers the wrong edges (lampshade, seed 13: 7 deg off for 55 frames). A
+  // gradient pass, which needs no references, pulls the pose onto the strongest edges; EPIC
+  // measures from both starts and the one whose pose keeps the larger share of its features
+  // is returned, with the references of that start.
+  Eigen::Isometry3d settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times);
+  void set_mode(TrackMode mode);
   const CadModel* model_;
   Camera camera_;
   ModelTrackerOptions options_;
@@ -141,6 +162,7 @@ class ModelTracker {
   std::vector<unsigned char> kept_last_;      // per model edge: found and kept by the pose last frame
   std::vector<unsigned char> kept_now_;
   bool was_lost_ = false;
+  bool settled_ = false;  // references learnt from a tracked frame (false: settle() first)
 };
 
 }  // namespace epichead::vision

@@ -3,6 +3,7 @@
 // edge points of model circles and optional 3D junctions: iteratively reweighted
 // Levenberg-Marquardt on SE(3) with a Tukey kernel, outlier flags per feature and the
 // pose covariance. The solver allocates nothing once the problem's buffers have grown.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
+#include "epichead/vision/revolution_axis.h"
 
 namespace epichead::vision {
 
@@ -51,7 +53,12 @@ struct PoseProblem {
   std::vector<PointObservation> points;
   std::vector<EllipseObservation> ellipses;
   std::vector<Point3dObservation> points_3d;
-  // Empties the problem; the vectors keep their capacity for the next frame.
+  // A body of revolution's axis: the turn about it is left at the prior (the features of a
+  // smooth surface modelled by facets do not show it) and the covariance gives it
+  // free_turn_sigma_rad. Unset for other models.
+  std::optional<RevolutionAxis> free_turn;
+  double free_turn_sigma_rad = 1.0;
+  // Empties the problem (free_turn stays); the vectors keep their capacity for the next frame.
   void clear();
 };
 

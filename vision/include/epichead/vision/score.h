@@ -17,12 +17,17 @@ namespace epichead::vision {
 struct ScoreCriterion {
   double max_translation_m = 0.05;
   double max_rotation_deg = 5.0;
+  // The accuracy criterion beside it: right by 5 cm / 5 deg can still sit on a printed border
+  // a few millimetres off the real edge.
+  double tight_translation_m = 0.02;
+  double tight_rotation_deg = 2.0;
 };
 
 struct FrameScore {
   int frame = 0;
   bool present = false;   // the frame has an estimate
   bool success = false;   // present and within the criterion
+  bool success_tight = false;  // present and within the tight criterion
   double rotation_deg = 0, translation_mm = 0, reprojection_px = 0;  // NaN when absent
 };
 
@@ -31,6 +36,8 @@ struct ErrorStats { double mean = 0, median = 0, p95 = 0; };
 struct ScoreSummary {
   int frames = 0, present = 0, succeeded = 0;
   double success_rate = 0;  // succeeded / frames
+  int succeeded_tight = 0;
+  double success_rate_tight = 0;  // succeeded_tight / frames
   int losses = 0;           // runs of consecutive failed frames
   ErrorStats rotation_deg, translation_mm, reprojection_px;  // over present frames
   std::vector<FrameScore> per_frame;
