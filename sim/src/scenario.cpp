@@ -224,6 +224,17 @@ class Parser {
       sc_.occluder_keys.push_back(k);
       return {};
     }};
+    rules_["cover"] = {2, 2, true, std::nullopt, [this](const Args& a) -> Status {
+      auto t = num(a[0], 0, 1e6);
+      if (!t) return std::unexpected(t.error());
+      auto d = num(a[1], 0.05, 1e6);
+      if (!d) return std::unexpected(d.error());
+      if (!sc_.covers.empty() && *t < sc_.covers.back().start_s + sc_.covers.back().duration_s)
+        return std::unexpected(where() + "'cover': windows must not overlap and must be in time order");
+      sc_.covers.push_back({*t, *d});
+      return {};
+    }};
+    numbers("variety", {&sc_.variety}, 0, 1);
 
     rules_["motion"] = {1, 1, false, std::nullopt, [this](const Args& a) -> Status {
       if (a[0] == "walking") sc_.motion = MotionKind::walking;
@@ -437,7 +448,7 @@ std::expected<Scenario, std::string> load_scenario(const std::string& path) {
 }
 
 const std::vector<std::string>& builtin_scenario_names() {
-  static const std::vector<std::string> names{"mockup_walk", "lampshade", "box_clutter", "office_pan"};
+  static const std::vector<std::string> names{"mockup_walk", "lampshade", "box_clutter", "office_pan", "can", "bowl"};
   return names;
 }
 

@@ -1,4 +1,4 @@
-// The four built-in scenes: geometry (model and render meshes), appearance, environment, light.
+// The built-in scenes: geometry (model and render meshes), appearance, environment, light.
 #include "epichead/sim/scene_library.h"
 
 #include <algorithm>
@@ -44,6 +44,44 @@ int add_quad_model(RawModel& raw, const Vector3d& a, const Vector3d& b, const Ve
 // Lamp shade geometry (object frame: bottom rim centre at the origin, axis +z).
 constexpr double kShadeBottomRadius = 0.12, kShadeTopRadius = 0.07, kShadeHeight = 0.16;
 constexpr int kShadeFacets = 36;
+
+// Can (object frame: bottom centre at the origin, axis +z): a cylinder modelled, as ViSP users do,
+// by its facets and its two rim circles; rendered smooth.
+constexpr double kCanRadius = 0.04, kCanHeight = 0.12;
+constexpr int kCanFacets = 32;
+
+// Bowl (object frame: bottom centre at the origin, axis +z): the profile's slope angle grows
+// linearly along its arc length s, so r(s) and z(s) are closed-form and the render can sample the
+// same curve finely. The model's rings are points of that curve; facets of neighbouring rings
+// differ by (end - start) / rings = 12 deg, below the 20 deg crease angle, so ring edges are not
+// tracked (no image edge there), only the rim circle and the silhouette.
+constexpr double kBowlFootRadius = 0.05, kBowlProfileLength = 0.10;
+constexpr double kBowlStartSlopeRad = 40.0 * std::numbers::pi / 180, kBowlEndSlopeRad = 88.0 * std::numbers::pi / 180;
+constexpr int kBowlRings = 4, kBowlFacets = 32;
+// (radius, height) of the bowl profile at fraction u (0 = foot, 1 = rim) of its arc length.
+Eigen::Vector2d bowl_profile(double u) {
+  const double k = (kBowlEndSlopeRad - kBowlStartSlopeRad) / kBowlProfileLength;
+  const double theta = kBowlStartSlopeRad + u * (kBowlEndSlopeRad - kBowlStartSlopeRad);
+  return {kBowlFootRadius + (std::sin(theta) - std::sin(kBowlStartSlopeRad)) / k,
+          (std::cos(kBowlStartSlopeRad) - std::cos(theta)) / k};
+}
+
+// Rings of `facets` vertices at the given (radius, height) profile points and the quads between
+// consecutive rings (CCW from outside): a body of revolution about z as ViSP users model one.
+void add_revolution_model(RawModel& raw, const std::vector<Eigen::Vector2d>& profile, int facets) {
+  const int first = static_cast<int>(raw.vertices.size());
+  for (const Eigen::Vector2d& rz : profile)
+    for (int i = 0; i < facets; ++i) {
+      const double a = 2 * std::numbers::pi * i / facets;
+      raw.vertices.emplace_back(rz.x() * std::cos(a), rz.x() * std::sin(a), rz.y());
+    }
+  for (std::size_t ring = 0; ring + 1 < profile.size(); ++ring)
+    for (int i = 0; i < facets; ++i) {
+      const int lo = first + static_cast<int>(ring) * facets, hi = lo + facets;
+      const int j = (i + 1) % facets;
+      raw.face_loops.push_back({lo + i, lo + j, hi + j, hi + i});
+    }
+}
 
 // Box of box_clutter: 0.20 x 0.15 x 0.10 m standing on the table, bottom centre at the origin.
 const Vector3d kPackageLo(-0.10, -0.075, 0.0), kPackageHi(0.10, 0.075, 0.10);
@@ -95,6 +133,16 @@ std::expected<vision::CadModel, std::string> model_of(std::string_view name) {
     raw.circles.push_back({Vector3d(0, 0, kShadeHeight), Vector3d::UnitZ(), kShadeTopRadius});
   } else if (name == "box_clutter") {
     add_box_model(raw, kPackageLo, kPackageHi);
+  } else if (name == "can") {
+    add_revolution_model(raw, {{kCanRadius, 0.0}, {kCanRadius, kCanHeight}}, kCanFacets);
+    raw.circles.push_back({Vector3d::Zero(), -Vector3d::UnitZ(), kCanRadius});
+    raw.circles.push_back({Vector3d(0, 0, kCanHeight), Vector3d::UnitZ(), kCanRadius});
+  } else if (name == "bowl") {
+    std::vector<Eigen::Vector2d> profile;
+    for (int ring = 0; ring <= kBowlRings; ++ring) profile.push_back(bowl_profile(static_cast<double>(ring) / kBowlRings));
+    add_revolution_model(raw, profile, kBowlFacets);
+    // The open top: its rim, facing out of the opening.
+    raw.circles.push_back({Vector3d(0, 0, profile.back().y()), Vector3d::UnitZ(), profile.back().x()});
   } else if (name == "office_pan") {
     add_quad_model(raw, {0, 0, 0}, {0, -kRoomY, 0}, {kRoomX, -kRoomY, 0}, {kRoomX, 0, 0});       // floor
     add_quad_model(raw, {0, 0, 0}, {kRoomX, 0, 0}, {kRoomX, 0, kRoomH}, {0, 0, kRoomH});         // back wall
@@ -112,6 +160,12 @@ std::expected<vision::CadModel, std::string> model_of(std::string_view name) {
 }
 
 // ---- appearance helpers ---------------------------------------------------------------------
+
+// The seed of one of the object's procedural prints: the built-in one for print_seed 0, else a
+// different print for each print_seed (scene variety draws new package prints, labels, plates).
+std::uint64_t print(std::uint64_t builtin_seed, std::uint64_t print_seed) {
+  return print_seed == 0 ? builtin_seed : builtin_seed ^ (print_seed * 0x9e3779b97f4a7c15ULL);
+}
 
 int add_texture(Scene& s, cv::Mat t) {
   s.textures.push_back(std::move(t));
@@ -209,7 +263,7 @@ void set_view(Scene& s, const Vector3d& camera, const Vector3d& target, double m
 
 // ---- the scenes -----------------------------------------------------------------------------
 
-std::expected<void, std::string> build_mockup_walk(Scene& s) {
+std::expected<void, std::string> build_mockup_walk(Scene& s, std::uint64_t print_seed) {
   const int px_per_m = 500;  // 2 mm per texture pixel
   // Plates: one grey family; welds only in the texture.
   std::vector<int> face_material;
@@ -235,7 +289,7 @@ std::expected<void, std::string> build_mockup_walk(Scene& s) {
       for (double y : {-0.260, -0.230, -0.200}) seams.push_back({{tx(-0.45), tv(y - 0.004)}, {tx(0.45), tv(y - 0.004)}});
     }
     Material m = grey(p.reflectance);
-    m.texture = add_texture(s, texture::steel_plate(tex, seams, 100 + part));
+    m.texture = add_texture(s, texture::steel_plate(tex, seams, print(100 + part, print_seed)));
     m.tex_origin_obj = horizontal ? Vector3d(p.lo.x(), p.hi.y(), p.hi.z()) : Vector3d(p.lo.x(), p.lo.y(), p.hi.z());
     m.tex_u_obj = Vector3d::UnitX();
     m.tex_v_obj = horizontal ? -Vector3d::UnitY() : -Vector3d::UnitZ();
@@ -258,14 +312,16 @@ std::expected<void, std::string> build_mockup_walk(Scene& s) {
   s.shadows.ground_z_m = 0.0;
   s.shadows.softness_px = 2.5;
   set_view(s, {0.35, -1.45, 0.8}, {0.05, 0.0, 0.3}, 1.0, 1.8);
+  s.variety_limits = {.object_yaw_deg = 10, .object_offset_m = 0.05, .orbit_deg = 12, .start_shift_m = 0.15,
+                      .heading_deg = 4, .passing_pole = true};
   return {};
 }
 
-std::expected<void, std::string> build_lampshade(Scene& s) {
+std::expected<void, std::string> build_lampshade(Scene& s, std::uint64_t print_seed) {
   constexpr double table_z = -0.25;
   // The shade: a smooth cone (the model's 36 facets would show as a polygon), open at both ends.
   Material shade = plain(0.62f, 0.76f, 0.86f);
-  shade.texture = add_texture(s, texture::fabric({256, 256}, 11));
+  shade.texture = add_texture(s, texture::fabric({256, 256}, print(11, print_seed)));
   shade.tex_u_obj = Vector3d::UnitX();
   shade.tex_v_obj = -Vector3d::UnitZ();
   shade.tex_px_per_m = 1600;
@@ -316,17 +372,20 @@ std::expected<void, std::string> build_lampshade(Scene& s) {
   s.shadows.enabled = true;
   s.shadows.ground_z_m = table_z;
   set_view(s, {0.05, -0.62, 0.22}, {0.0, 0.0, 0.07}, 0.45, 1.0);
+  // The shade stays on its lamp (no offset); turning it only turns its reflectance gradient.
+  s.variety_limits = {.object_yaw_deg = 180, .object_offset_m = 0, .orbit_deg = 25, .start_shift_m = 0.03,
+                      .heading_deg = 5, .passing_pole = false};
   return {};
 }
 
-std::expected<void, std::string> build_box_clutter(Scene& s) {
+std::expected<void, std::string> build_box_clutter(Scene& s, std::uint64_t print_seed) {
   std::vector<int> face_material;
   constexpr double px_per_m = 3000;  // 0.33 mm per texture pixel: sharp from 0.35 m
   for (int f = 0; f < 6; ++f) {
     Material m = plain(1.f, 1.f, 1.f);
     map_texture_on_face(m, s.model, f, px_per_m);
     const cv::Size tex = face_texture_size(s.model, f, px_per_m);
-    m.texture = add_texture(s, texture::package_face(tex, f, 40 + static_cast<std::uint64_t>(f)));
+    m.texture = add_texture(s, texture::package_face(tex, f, print(40 + static_cast<std::uint64_t>(f), print_seed)));
     face_material.push_back(add_material(s, m));
   }
   s.object_mesh = mesh_from_model(s.model, face_material);
@@ -346,19 +405,22 @@ std::expected<void, std::string> build_box_clutter(Scene& s) {
   s.shadows.enabled = true;
   s.shadows.ground_z_m = 0.0;
   set_view(s, {0.12, -0.5, 0.32}, {0.0, 0.0, 0.05}, 0.35, 0.9);
+  // Turned by up to 35 deg and seen from up to 25 deg around: still two sides and the top.
+  s.variety_limits = {.object_yaw_deg = 35, .object_offset_m = 0.04, .orbit_deg = 25, .start_shift_m = 0.03,
+                      .heading_deg = 5, .passing_pole = true};
   return {};
 }
 
-std::expected<void, std::string> build_office_pan(Scene& s) {
+std::expected<void, std::string> build_office_pan(Scene& s, std::uint64_t print_seed) {
   // Materials 0..5 as the model's faces use them: floor, back wall, left wall, frame, desk top, legs.
   Material floor = plain(1.f, 1.f, 1.f);
-  floor.texture = add_texture(s, texture::parquet({1024, 1024}, 51));
+  floor.texture = add_texture(s, texture::parquet({1024, 1024}, print(51, print_seed)));
   floor.tex_u_obj = Vector3d::UnitX();
   floor.tex_v_obj = -Vector3d::UnitY();
   floor.tex_px_per_m = 400;
   add_material(s, floor);
   Material back = plain(0.72f, 0.78f, 0.80f);
-  back.texture = add_texture(s, texture::plaster({512, 512}, cv::Scalar(245, 245, 245), 52));
+  back.texture = add_texture(s, texture::plaster({512, 512}, cv::Scalar(245, 245, 245), print(52, print_seed)));
   back.tex_u_obj = Vector3d::UnitX();
   back.tex_v_obj = -Vector3d::UnitZ();
   back.tex_px_per_m = 200;
@@ -370,7 +432,7 @@ std::expected<void, std::string> build_office_pan(Scene& s) {
   add_material(s, left);
   add_material(s, plain(0.86f, 0.88f, 0.88f));  // door frame: white paint
   Material top = plain(1.f, 1.f, 1.f);
-  top.texture = add_texture(s, texture::wood({512, 512}, 53));
+  top.texture = add_texture(s, texture::wood({512, 512}, print(53, print_seed)));
   top.tex_u_obj = Vector3d::UnitX();
   top.tex_v_obj = -Vector3d::UnitY();
   top.tex_px_per_m = 500;
@@ -421,13 +483,94 @@ std::expected<void, std::string> build_office_pan(Scene& s) {
   s.light.diffuse = 0.45;
   s.shadows.enabled = false;
   set_view(s, {3.5, -4.7, 0.9}, {1.7, 0.0, 0.9}, 2.0, 6.0);
+  // The object is the room: it does not move, and the drive stays inside it.
+  s.variety_limits = {.object_yaw_deg = 0, .object_offset_m = 0, .orbit_deg = 0, .start_shift_m = 0.25,
+                      .heading_deg = 3, .passing_pole = false};
+  return {};
+}
+
+// A table top with clutter around it: a wooden floor plane at z = 0 and four walls of photos
+// and clutter (can, bowl).
+std::expected<void, std::string> add_table_surroundings(Scene& s, std::uint64_t clutter_seed, std::uint64_t wood_seed) {
+  auto desk = photo("stuff.jpg");
+  if (!desk) return std::unexpected(desk.error());
+  auto street = photo("building.jpg");
+  if (!street) return std::unexpected(street.error());
+  auto graffiti = photo("graf1.jpg");
+  if (!graffiti) return std::unexpected(graffiti.error());
+  const int t_desk = add_texture(s, *desk), t_street = add_texture(s, *street), t_graf = add_texture(s, *graffiti);
+  const int t_clutter = add_texture(s, texture::clutter({1024, 640}, clutter_seed));
+  add_walls(s, 0, 0, 1.0, 1.0, 0.0, 1.2, {t_desk, t_clutter, t_graf, t_street});
+  s.background.planes.push_back(floor_plane(0.0, Vector3d::Zero(), 2.0, 2.0, add_texture(s, texture::wood({512, 512}, wood_seed)), 800));
+  s.background.plain_bgr = {0.8f, 0.8f, 0.8f};
+  s.shadows.enabled = true;
+  s.shadows.ground_z_m = 0.0;
+  return {};
+}
+
+std::expected<void, std::string> build_can(Scene& s, std::uint64_t print_seed) {
+  // Smooth side (256 segments; the model's 32 facets would show as a polygon) in three bands:
+  // a metal foot, the printed label, a metal shoulder; a lid and a bottom.
+  constexpr double foot = 0.012, shoulder = 0.108, px_per_m = 3000;
+  const int metal = add_material(s, plain(0.52f, 0.54f, 0.56f));
+  const int lid = add_material(s, plain(0.42f, 0.44f, 0.46f));
+  Material label = plain(1.f, 1.f, 1.f);
+  // Planar mapping seen from -y: the print spans the can's width; toward the silhouette it is
+  // foreshortened as a real label is.
+  label.tex_origin_obj = Vector3d(-kCanRadius, 0, shoulder);
+  label.tex_u_obj = Vector3d::UnitX();
+  label.tex_v_obj = -Vector3d::UnitZ();
+  label.tex_px_per_m = px_per_m;
+  label.texture = add_texture(s, texture::package_face({static_cast<int>(std::lround(2 * kCanRadius * px_per_m)),
+                                                         static_cast<int>(std::lround((shoulder - foot) * px_per_m))},
+                                                        1, print(61, print_seed)));
+  const int label_mat = add_material(s, label);
+  auto at_z = [](double z) { return Eigen::Isometry3d(Eigen::Translation3d(0, 0, z)); };
+  add_frustum(s.object_mesh, at_z(0), kCanRadius, kCanRadius, foot, 256, Caps::None, metal);
+  add_frustum(s.object_mesh, at_z(foot), kCanRadius, kCanRadius, shoulder - foot, 256, Caps::None, label_mat);
+  add_frustum(s.object_mesh, at_z(shoulder), kCanRadius, kCanRadius, kCanHeight - shoulder, 256, Caps::None, metal);
+  add_disc(s.object_mesh, at_z(kCanHeight), kCanRadius, 0, 256, lid);
+  Eigen::Isometry3d bottom = at_z(0);
+  bottom.linear() = Eigen::AngleAxisd(std::numbers::pi, Vector3d::UnitX()).toRotationMatrix();
+  add_disc(s.object_mesh, bottom, kCanRadius, 0, 256, lid);
+
+  if (auto ok = add_table_surroundings(s, 71, 72); !ok) return ok;
+  s.light.direction_world = Vector3d(0.4, -0.5, 1.0).normalized();
+  set_view(s, {0.05, -0.42, 0.2}, {0.0, 0.0, 0.06}, 0.3, 0.8);
+  s.variety_limits = {.object_yaw_deg = 30, .object_offset_m = 0.04, .orbit_deg = 30, .start_shift_m = 0.03,
+                      .heading_deg = 5, .passing_pole = true};
+  return {};
+}
+
+std::expected<void, std::string> build_bowl(Scene& s, std::uint64_t print_seed) {
+  (void)print_seed;  // a plain glaze: nothing printed
+  // Smooth: 48 profile rings of 256 segments (normals of neighbouring rings differ by 1 deg), one
+  // open surface whose back is the inside seen through the opening, and a flat inner bottom.
+  Material glaze = plain(0.72f, 0.50f, 0.30f);
+  glaze.gradient_per_m_obj = Vector3d(0, 0, 1.5);  // a little lighter toward the rim, as glazes run
+  const int glaze_mat = add_material(s, glaze);
+  constexpr int render_rings = 48;
+  s.object_mesh.closed = false;
+  for (int i = 0; i < render_rings; ++i) {
+    const Eigen::Vector2d a = bowl_profile(static_cast<double>(i) / render_rings);
+    const Eigen::Vector2d b = bowl_profile(static_cast<double>(i + 1) / render_rings);
+    add_frustum(s.object_mesh, Eigen::Isometry3d(Eigen::Translation3d(0, 0, a.y())), a.x(), b.x(), b.y() - a.y(), 256,
+                Caps::None, glaze_mat);
+  }
+  add_disc(s.object_mesh, Eigen::Isometry3d::Identity(), kBowlFootRadius, 0, 256, glaze_mat);
+
+  if (auto ok = add_table_surroundings(s, 81, 82); !ok) return ok;
+  s.light.direction_world = Vector3d(-0.3, -0.5, 1.0).normalized();
+  set_view(s, {0.05, -0.45, 0.3}, {0.0, 0.0, 0.04}, 0.3, 0.8);
+  s.variety_limits = {.object_yaw_deg = 180, .object_offset_m = 0.04, .orbit_deg = 30, .start_shift_m = 0.03,
+                      .heading_deg = 5, .passing_pole = true};
   return {};
 }
 
 }  // namespace
 
 const std::vector<std::string>& scene_names() {
-  static const std::vector<std::string> names = {"mockup_walk", "lampshade", "box_clutter", "office_pan"};
+  static const std::vector<std::string> names = {"mockup_walk", "lampshade", "box_clutter", "office_pan", "can", "bowl"};
   return names;
 }
 
@@ -443,17 +586,19 @@ std::string scene_model_path(std::string_view name) { return scenes_dir() + "/" 
 
 std::expected<vision::CadModel, std::string> make_scene_model(std::string_view name) { return model_of(name); }
 
-std::expected<Scene, std::string> make_scene(std::string_view name) {
+std::expected<Scene, std::string> make_scene(std::string_view name, std::uint64_t print_seed) {
   auto model = model_of(name);
   if (!model) return std::unexpected(model.error());
   Scene s;
   s.name = std::string(name);
   s.model = std::move(*model);
   std::expected<void, std::string> ok;
-  if (name == "mockup_walk") ok = build_mockup_walk(s);
-  else if (name == "lampshade") ok = build_lampshade(s);
-  else if (name == "box_clutter") ok = build_box_clutter(s);
-  else ok = build_office_pan(s);
+  if (name == "mockup_walk") ok = build_mockup_walk(s, print_seed);
+  else if (name == "lampshade") ok = build_lampshade(s, print_seed);
+  else if (name == "box_clutter") ok = build_box_clutter(s, print_seed);
+  else if (name == "office_pan") ok = build_office_pan(s, print_seed);
+  else if (name == "can") ok = build_can(s, print_seed);
+  else ok = build_bowl(s, print_seed);
   if (!ok) return std::unexpected(ok.error());
   return s;
 }

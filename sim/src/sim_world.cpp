@@ -7,6 +7,7 @@
 #include "epichead/firmware_iface/time_sync.h"
 #include "epichead/sim/rig.h"
 #include "epichead/sim/scene_library.h"
+#include "epichead/sim/scene_variety.h"
 #include "epichead/sim/sim_camera.h"
 
 namespace epichead::sim {
@@ -61,7 +62,16 @@ SimWorld::SimWorld(const Scenario& scenario, const SimWorldOptions& options)
 
 SimWorld::~SimWorld() = default;
 
-std::expected<std::unique_ptr<SimWorld>, std::string> SimWorld::create(const Scenario& s, const SimWorldOptions& options) {
+std::expected<std::unique_ptr<SimWorld>, std::string> SimWorld::create(const Scenario& given, const SimWorldOptions& options) {
+  // A seed's scene variety and the cover boards change the camera path, light and occluder keys
+  // as well as the scene: the world runs the scenario as write_sequence does.
+  std::optional<ScenarioScene> varied;
+  if (given.variety > 0 || !given.covers.empty()) {
+    auto made = make_scenario_scene(given);
+    if (!made) return std::unexpected(made.error());
+    varied = std::move(*made);
+  }
+  const Scenario& s = varied ? varied->scenario : given;
   if (auto ok = check(options, s.head_dynamics); !ok) return std::unexpected(ok.error());
   auto camera = scenario_camera(s);
   if (!camera) return std::unexpected(camera.error());
@@ -71,9 +81,13 @@ std::expected<std::unique_ptr<SimWorld>, std::string> SimWorld::create(const Sce
   // The scene: needed to render, and for its view target when the scenario names no aim.
   std::optional<Scene> scene;
   if (options.camera == CameraOutput::Render || (!s.aim_world && !s.head_deg)) {
-    auto made = make_scene(s.scene);
-    if (!made) return std::unexpected(made.error());
-    scene = std::move(*made);
+    if (varied) {
+      scene = std::move(varied->scene);
+    } else {
+      auto made = make_scene(s.scene);
+      if (!made) return std::unexpected(made.error());
+      scene = std::move(*made);
+    }
     w->world_T_obj_ = scene->world_T_obj;
   }
   const double exposure_s = s.exposure_s.value_or(scene ? scene->exposure_s : 0.008);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
@@ -14,6 +15,7 @@
 #include "epichead/sim/renderer.h"
 #include "epichead/sim/rig.h"
 #include "epichead/sim/scene_library.h"
+#include "epichead/sim/scene_variety.h"
 #include "epichead/vision/sequence.h"
 #include "epichead/vision/stamped_pose.h"
 #include "occluder_motion.h"
@@ -56,10 +58,13 @@ std::expected<void, std::string> write_text(const fs::path& path, const std::str
 
 }  // namespace
 
-std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const std::string& out_dir,
+std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, const std::string& out_dir,
                                                       const FrameProgress& progress) {
-  auto scene = make_scene(s.scene);
-  if (!scene) return std::unexpected(scene.error());
+  // The scene and scenario as they run: the seed's scene variety and the cover boards applied.
+  auto made = make_scenario_scene(scenario);
+  if (!made) return std::unexpected(made.error());
+  const Scenario& s = made->scenario;
+  std::optional<Scene> scene(std::move(made->scene));
   auto camera = scenario_camera(s);
   if (!camera) return std::unexpected(camera.error());
   if (auto ok = prepare_dir(out_dir); !ok) return std::unexpected(ok.error());
@@ -141,7 +146,10 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& s, const s
     << ",\n    \"dropped\": " << imu.dropped << ",\n    \"saturated\": " << imu.saturated
     << ",\n    \"gyro_scale\": " << vec(imu.gyro_scale) << ",\n    \"accel_scale\": " << vec(imu.accel_scale)
     << ",\n    \"gyro_bias0_radps\": " << vec(imu.gyro_bias0_radps) << ",\n    \"accel_bias0_mps2\": "
-    << vec(imu.accel_bias0_mps2) << "\n  }\n}\n";
+    << vec(imu.accel_bias0_mps2) << "\n  }";
+  // Only with variety or covers, so that a built-in scene's output stays as it always was.
+  if (s.variety > 0 || !s.covers.empty()) j << ",\n  \"scene_variety\": " << to_json(made->drawn, "  ");
+  j << "\n}\n";
   if (auto ok = write_text(dir / "sim_truth.json", j.str()); !ok) return std::unexpected(ok.error());
   if (auto ok = write_text(dir / "scenario.scn", s.text); !ok) return std::unexpected(ok.error());
 

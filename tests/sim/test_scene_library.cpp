@@ -39,7 +39,7 @@ Eigen::Vector3d direction(const vision::CadModel& m, const vision::ModelEdge& e)
 }  // namespace
 
 TEST_CASE("every built-in scene builds and its model file matches the model built in code", "[scene_library]") {
-  REQUIRE(sim::scene_names().size() == 4);
+  REQUIRE(sim::scene_names().size() == 6);
   for (const auto& name : sim::scene_names()) {
     CAPTURE(name);
     auto scene = sim::make_scene(name);
@@ -175,6 +175,52 @@ TEST_CASE("lampshade: two rim circles, facets below the crease angle, an open su
   for (const auto& mat : scene->materials)
     varies = varies || (mat.gradient_per_m_obj.norm() > 0 && mat.gradient_swing > 0 && mat.change_amplitude > 0);
   CHECK(varies);
+}
+
+// Facets of a body of revolution: every pair of neighbouring faces is below the crease angle
+// (their shared edge makes no image edge and is not tracked).
+void check_facets_below_crease(const vision::CadModel& m) {
+  const double crease = vision::VisibilityOptions{}.crease_angle_rad;
+  for (const auto& e : m.edges) {
+    if (e.face_count() != 2) continue;
+    const double angle = std::acos(std::clamp(m.faces[static_cast<std::size_t>(e.faces[0])].normal_obj.dot(
+                                                  m.faces[static_cast<std::size_t>(e.faces[1])].normal_obj),
+                                              -1.0, 1.0));
+    CHECK(angle < crease);
+  }
+}
+
+TEST_CASE("can: 32 facets and two rim circles, 4 cm radius, 12 cm high, a smooth printed render", "[scene_library]") {
+  auto scene = sim::make_scene("can");
+  REQUIRE(scene);
+  const vision::CadModel& m = scene->model;
+  CHECK(m.faces.size() == 32);
+  REQUIRE(m.circles.size() == 2);
+  CHECK(m.circles[0].radius_m == Approx(0.04));
+  CHECK(m.circles[1].centre_obj.z() == Approx(0.12));
+  check_facets_below_crease(m);
+  // The render is much finer than the model (smooth, not a 32-gon).
+  CHECK(scene->object_mesh.triangles.size() > 8 * m.faces.size() * 2);
+  int textured = 0;
+  for (const auto& mat : scene->materials) textured += mat.texture >= 0;
+  CHECK(textured >= 1);
+  CHECK(scene->occluders.empty());
+}
+
+TEST_CASE("bowl: 4 rings of 32 facets below the crease angle, an open top with its rim circle", "[scene_library]") {
+  auto scene = sim::make_scene("bowl");
+  REQUIRE(scene);
+  const vision::CadModel& m = scene->model;
+  CHECK(m.faces.size() == 4 * 32);
+  CHECK_FALSE(m.closed);
+  REQUIRE(m.circles.size() == 1);
+  CHECK(m.circles[0].normal_obj.z() == Approx(1));
+  // Curved profile: the facets' slope changes from ring to ring.
+  CHECK(std::abs(m.faces[0].normal_obj.z()) > std::abs(m.faces[3 * 32].normal_obj.z()) + 0.3);
+  check_facets_below_crease(m);
+  // Every model vertex lies on the rendered surface's profile (to the 32-gon's sagitta).
+  for (const auto& p : m.vertices) CHECK(p.head<2>().norm() <= m.circles[0].radius_m + 1e-9);
+  CHECK_FALSE(scene->object_mesh.closed);
 }
 
 TEST_CASE("box_clutter: a 20 x 15 x 10 cm textured box over photographs", "[scene_library]") {

@@ -135,6 +135,20 @@ TEST_CASE("sim output is byte-identical for a seed and differs for another seed"
   CHECK(!fs::exists(a / "frames" / "000004.png"));
 }
 
+TEST_CASE("sim: --seed alone draws a new scene (variety 1), --variety 0 keeps the built-in one", "[tools][sim]") {
+  const fs::path a = scratch() / "va", b = scratch() / "vb", c = scratch() / "vc";
+  REQUIRE(run("can --out '" + a.string() + "' --frames 1 --seed 11").code == 0);
+  REQUIRE(run("can --out '" + b.string() + "' --frames 1 --seed 11 --variety 0").code == 0);
+  REQUIRE(run("can --out '" + c.string() + "' --frames 1 --variety 0.5").code == 0);
+  const std::string ja = slurp(a / "sim_truth.json"), jb = slurp(b / "sim_truth.json"), jc = slurp(c / "sim_truth.json");
+  CHECK(ja.find("\"scene_variety\": {\n    \"variety\": 1,") != std::string::npos);
+  CHECK(ja.find("\"plane_textures\"") != std::string::npos);
+  // can.scn has a cover window, so its draws are recorded even at variety 0.
+  CHECK(jb.find("\"variety\": 0,") != std::string::npos);
+  CHECK(jc.find("\"variety\": 0.5,") != std::string::npos);
+  CHECK(run("can --out '" + c.string() + "' --frames 1 --variety 2").code != 0);
+}
+
 TEST_CASE("sim rejects bad input with one line naming the reason", "[tools][sim]") {
   const auto one_line = [](const Run& r) {
     CHECK(r.code != 0);

@@ -35,6 +35,13 @@ struct OccluderKey {
   Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
 };
 
+// A window in which a large board slides in front of the camera and hides the tracked object
+// completely (key `cover`): the tracker must notice the loss and recover afterwards.
+struct CoverWindow {
+  double start_s = 0;     // the board starts to slide in
+  double duration_s = 1;  // how long the object is fully hidden
+};
+
 struct Scenario {
   std::string name;          // file stem (built-in name for built-ins)
   std::string text;          // the file's text, copied into the sequence for reproduction
@@ -51,6 +58,11 @@ struct Scenario {
   double init_error_m = 0.01, init_error_deg = 1.0;  // init.csv perturbation of the frame-0 truth
   std::vector<LightKey> light;       // empty: gain 1
   std::vector<OccluderKey> occluder_keys;  // occluders without keys follow the scene's default path
+  std::vector<CoverWindow> covers;         // in file order
+  // How far the seed moves the scene away from the one the tracker was tuned on (0..1):
+  // background, light, object look and placement, camera path, occluders (scene_variety.h).
+  // 0 = the built-in scene exactly.
+  double variety = 0;
 
   MotionKind motion = MotionKind::walking;
   WalkingParams walking;
@@ -76,7 +88,7 @@ struct Scenario {
 // directory. Every error is "name:line: what".
 std::expected<Scenario, std::string> parse_scenario(const std::string& text, const std::string& name);
 std::expected<Scenario, std::string> load_scenario(const std::string& path);
-// A built-in name (mockup_walk, lampshade, box_clutter, office_pan) or a path to a .scn file.
+// A built-in name (mockup_walk, lampshade, box_clutter, office_pan, can, bowl) or a path to a .scn file.
 std::expected<Scenario, std::string> find_scenario(const std::string& name_or_path);
 const std::vector<std::string>& builtin_scenario_names();
 std::string scenarios_dir();  // sim/scenarios in the source tree

@@ -116,6 +116,18 @@ struct ViewHint {
   double min_distance_m = 0.5, max_distance_m = 2;         // the object stays well framed in this range
 };
 
+// How far a seed's scene variety (scene_variety.h) may move things in this scene at variety 1:
+// what keeps the scene plausible (a room does not turn, a lamp shade stays on its lamp) and the
+// object in a useful, non-degenerate view.
+struct VarietyLimits {
+  double object_yaw_deg = 0;   // turn of the object on its support about world z
+  double object_offset_m = 0;  // shift of the object on its support along world x and y
+  double orbit_deg = 0;        // the camera's start turned about the object (world z)
+  double start_shift_m = 0;    // and shifted along world x and y
+  double heading_deg = 4;      // the body's heading turned
+  bool passing_pole = false;   // a pole may pass in front of the object (scenes without occluders)
+};
+
 // A default path for an occluder: its pose moves linearly from world_T_start to world_T_end
 // and back (a triangle wave of period_s), starting at start_s; before start_s it stays at start.
 struct OccluderPath {
@@ -144,6 +156,7 @@ struct Scene {
   Light light;
   Shadows shadows;
   ViewHint view;
+  VarietyLimits variety_limits;
   int blur_subframes = 4;         // sub-frames per frame the scene is meant to be rendered with
   double exposure_s = 0.008;      // exposure time those sub-frames should span
 };

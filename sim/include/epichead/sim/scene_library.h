@@ -1,5 +1,5 @@
 #pragma once
-// The four built-in scenes. Each puts its tracked object at the world origin (world z up) and
+// The built-in scenes. Each puts its tracked object at the world origin (world z up) and
 // says in Scene::view where a camera should look from.
 //
 //   mockup_walk  a ship-section mockup, 1.0 m wide x 0.5 m deep x 0.8 m high (origin: floor under
@@ -16,6 +16,14 @@
 //   office_pan   a room corner seen from a wheeled robot: two walls and the floor, a door frame,
 //                a desk with legs; 4 m x 5 m x 2.5 m; corner at the origin, back wall y = 0, left
 //                wall x = 0, the room toward +x, -y.
+//   can          a printed can (cylinder, radius 0.04 m, height 0.12 m; origin: bottom centre, axis
+//                +z) on a wooden table with photos and clutter around; rendered smooth, modelled by
+//                32 facets (below the crease angle) and the two rim circles.
+//   bowl         a glazed bowl (body of revolution with a curved profile: foot radius 0.05 m, rim
+//                radius 0.094 m at 0.087 m; origin: bottom centre, axis +z) on the same kind of
+//                table; rendered smooth (48 x 256 facets), modelled by 4 rings of 32 facets (12 deg
+//                apart, below the crease angle) and the open top's rim circle.
+#include <cstdint>
 #include <expected>
 #include <string>
 #include <string_view>
@@ -29,8 +37,10 @@ namespace epichead::sim {
 const std::vector<std::string>& scene_names();
 
 // Builds a built-in scene (model, meshes, procedural textures; photos from scenes_dir()).
-// Errors name the unknown scene (with the known ones) or the photo that could not be read.
-std::expected<Scene, std::string> make_scene(std::string_view name);
+// `print_seed` 0 gives the object's built-in procedural prints (package faces, label, plates),
+// any other value a different set (scene variety). Errors name the unknown scene (with the
+// known ones) or the photo that could not be read.
+std::expected<Scene, std::string> make_scene(std::string_view name, std::uint64_t print_seed = 0);
 
 // The tracked object's wire-frame of a built-in scene, as written to scenes_dir()/<name>.cao
 // (a sequence's model.cao is a copy of that file).
