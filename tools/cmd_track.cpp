@@ -42,6 +42,7 @@ struct TrackArgs {
   double max_view_deg = 85.0;
   std::string imu_time_offset = "auto";
   std::string free_turn = "auto";
+  bool settle = true;
   std::uint32_t ransac_seed = RansacOptions{}.seed;
 };
 
@@ -157,6 +158,7 @@ int run_track(const TrackArgs& args) {
   options.lines.epic.ransac.seed = args.ransac_seed;
   if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
   options.free_turn_of_revolution = args.free_turn == "auto";
+  options.settle = args.settle;
   ModelTracker tracker(seq->model(), seq->camera(), options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
@@ -339,6 +341,9 @@ const CommandRegistration registration{
       app.add_option("--free-turn", a->free_turn,
                      "auto (default): a model that is a body of revolution (facets and coaxial rims) leaves its turn "
                      "about the axis to the prediction, and its covariance says so; off: the pose fits all six degrees");
+      app.add_flag("!--no-settle", a->settle,
+                   "Measure the first frame (and the first after a loss) from the start pose only, without the "
+                   "gradient pass that settles the start before the cue references are learnt");
       app.add_option("--ransac-seed", a->ransac_seed,
                      "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");
       return [a]() { return run_track(*a); };

@@ -255,3 +255,36 @@ TEST_CASE("no ground truth gives an empty summary and a zero axis is refused") {
   CHECK(std::isnan(s.rotation_deg.mean));
   CHECK_THROWS_AS(score_poses(truth(1), truth(1), kCamera, cube(), Eigen::Vector3d::Zero()), std::invalid_argument);
 }
+
+TEST_CASE("the tight 2 cm / 2 degree criterion counts only the frames within it") {
+  // Frames 0-1 are 15 mm off, 2-3 are 30 mm off, 4-5 are turned 3 degrees, frame 6 has no estimate.
+  const auto gt = truth(7);
+  std::vector<StampedPose> est;
+  const auto near = perturbed(gt, {0, 0, 1}, 0, {0.009, 0, 0.012});   // 15 mm
+  const auto far = perturbed(gt, {0, 0, 1}, 0, {0.018, -0.024, 0});   // 30 mm
+  const auto turned = perturbed(gt, {1, -0.5, 0.2}, 3 * kDeg);
+  est = {near[0], near[1], far[2], far[3], turned[4], turned[5]};
+  const ScoreSummary s = score_poses(gt, est, kCamera, cube());
+  REQUIRE(s.per_frame.size() == 7);
+  CHECK(s.per_frame[0].translation_mm == Approx(15.0).epsilon(1e-9));
+  CHECK(s.per_frame[2].translation_mm == Approx(30.0).epsilon(1e-9));
+  CHECK(s.per_frame[4].rotation_deg == Approx(3.0).epsilon(1e-9));
+  for (int i : {0, 1}) {
+    CHECK(s.per_frame[i].success);
+    CHECK(s.per_frame[i].success_tight);
+  }
+  for (int i : {2, 3, 4, 5}) {
+    CHECK(s.per_frame[i].success);          // within 5 cm / 5 deg
+    CHECK_FALSE(s.per_frame[i].success_tight);  // not within 2 cm / 2 deg
+  }
+  CHECK_FALSE(s.per_frame[6].success_tight);
+  CHECK(s.succeeded == 6);
+  CHECK(s.success_rate == Approx(6.0 / 7.0));
+  CHECK(s.succeeded_tight == 2);
+  CHECK(s.success_rate_tight == Approx(2.0 / 7.0));
+
+  // The tight criterion is the one given: at 4 cm / 4 deg every present frame passes it.
+  const ScoreSummary looser = score_poses(gt, est, kCamera, cube(), std::nullopt, ScoreCriterion{0.05, 5.0, 0.04, 4.0});
+  CHECK(looser.succeeded_tight == 6);
+  CHECK(looser.success_rate_tight == Approx(6.0 / 7.0));
+}

@@ -15,7 +15,8 @@ ObjectSide object_side(RimSide side) {
   switch (side) {
     case RimSide::Inside: return ObjectSide::Left;
     case RimSide::Outside: return ObjectSide::Right;
-    case RimSide::Both: break;
+    case RimSide::Both:
+    case RimSide::Model: break;
   }
   return ObjectSide::Both;
 }
@@ -93,7 +94,7 @@ void EllipseTracker::track(const WindowImage& image, const VisibleModel& visible
     projection.semi_major_px = v.semi_major_px;
     projection.semi_minor_px = v.semi_minor_px;
     projection.angle_rad = v.angle_rad;
-    track_one(image, v.circle, projection, placement);
+    track_one(image, v.circle, projection, placement, v.side);
   }
 }
 
@@ -119,7 +120,8 @@ bool EllipseTracker::place(const WindowImage& image, EllipseFeature& f, const El
   return window_.sample(image, f.lines.data(), static_cast<int>(f.lines.size()));
 }
 
-void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement) {
+void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
+                               ObjectSide model_side) {
   if (circle < 0) return;
   EllipseFeature& f = feature(circle);
   f.visible = f.found = f.weak = false;
@@ -127,7 +129,7 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
   f.candidates.clear();
   f.candidate_inliers.clear();
   f.row_hit.clear();
-  f.side = object_side(options_.side);
+  f.side = options_.side == RimSide::Model ? model_side : object_side(options_.side);
   if (!projection.valid()) { f.has_previous = false; return; }
   if (!f.refs.initialised && options_.mode != EpicMode::Gradient) {
     // References from both sides of the projected contour, whatever the placement.

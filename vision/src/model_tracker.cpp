@@ -74,6 +74,7 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
       camera_(camera),
       options_(options),
       visibility_(model, camera, options.visibility),
+      rim_sides_(model, camera),
       lines_(line_options(options)),
       ellipses_(ellipse_options(options)),
       validator_(model, options.validation),
@@ -90,6 +91,23 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   }
   problem_.points.reserve(model.vertices.size());
   if (options.free_turn_of_revolution) problem_.free_turn = find_revolution_axis(model);
+  // Model edges that are chords of a model circle (both ends on it): the facets' outline of a
+  // rim the circle itself describes.
+  chord_of_circle_.assign(edges, -1);
+  for (std::size_t e = 0; e < edges; ++e) {
+    const Eigen::Vector3d& a = model.vertices[static_cast<std::size_t>(model.edges[e].v0)];
+    const Eigen::Vector3d& b = model.vertices[static_cast<std::size_t>(model.edges[e].v1)];
+    for (std::size_t c = 0; c < model.circles.size() && chord_of_circle_[e] < 0; ++c) {
+      const ModelCircle& k = model.circles[c];
+      const Eigen::Vector3d n = k.normal_obj.normalized();
+      const double tol = 1e-3 * k.radius_m + 1e-6;
+      const auto on = [&](const Eigen::Vector3d& p) {
+        const Eigen::Vector3d d = p - k.centre_obj;
+        return std::abs(d.dot(n)) <= tol && std::abs((d - d.dot(n) * n).norm() - k.radius_m) <= tol;
+      };
+      if (on(a) && on(b)) chord_of_circle_[e] = static_cast<int>(c);
+    }
+  }
   // One slot per model circle, like the lines (a slot without points is ignored).
   problem_.ellipses.resize(model.circles.size());
   for (std::size_t c = 0; c < model.circles.size(); ++c) {
@@ -158,6 +176,18 @@ void ModelTracker::build_problem() {
 bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& predicted, FrameReport& out) {
   auto t = Clock::now();
   visibility_.compute(predicted, visible_);
+  rim_sides_.apply(predicted, visible_);
+  if (options_.circles_replace_chords && !visible_.ellipses.empty()) {
+    // A rim seen as an ellipse is tracked as one: its chords would count it a second time,
+    // thirty-odd short windows that a printed band along the rim pulls off together.
+    std::erase_if(visible_.edges, [&](const VisibleEdge& e) {
+      const int c = static_cast<std::size_t>(e.edge) < chord_of_circle_.size() ? chord_of_circle_[static_cast<std::size_t>(e.edge)] : -1;
+      if (c < 0 || e.kind == EdgeKind::CylinderSilhouette) return false;
+      for (const VisibleEllipse& v : visible_.ellipses)
+        if (v.circle == c) return true;
+      return false;
+    });
+  }
   out.times.visibility_ms += ms_since(t);
 
   t = Clock::now();
@@ -311,7 +341,7 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   out = FrameReport{};
   out.cam_T_obj = predicted;
   StageTimes settling;
-  const Eigen::Isometry3d start = settled_ ? predicted : settle(image, predicted, settling);
+  const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling);
   bool pose_ok = measure(image, start, out);
   out.times.visibility_ms += settling.visibility_ms;
   out.times.epic_ms += settling.epic_ms;

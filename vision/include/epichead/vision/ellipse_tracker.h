@@ -27,6 +27,7 @@ enum class RimSide {
   Inside,   // a disc, or a rim whose surface is seen inside its image (a lamp shade from above)
   Outside,  // a hole in a surface
   Both,
+  Model,    // what the model says for each rim at the pose (VisibleEllipse::side, rim_side.h)
 };
 
 struct EllipseTrackerOptions {
@@ -85,7 +86,9 @@ class EllipseTracker {
   // the first time a circle is seen).
   void track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement);
   // Tracks one ellipse given directly (tests, benchmarks): `circle` indexes the features.
-  void track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement);
+  // With RimSide::Model the side is `model_side` (Both when not given).
+  void track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
+                 ObjectSide model_side = ObjectSide::Both);
   // Indexed by model circle; only entries with visible == true were processed this frame.
   const std::vector<EllipseFeature>& features() const { return features_; }
   // Image point of an edgel of a feature's result.

@@ -18,6 +18,7 @@
 #include "epichead/vision/ellipse_tracker.h"
 #include "epichead/vision/line_tracker.h"
 #include "epichead/vision/pose_estimator.h"
+#include "epichead/vision/rim_side.h"
 #include "epichead/vision/topology_validator.h"
 #include "epichead/vision/visibility.h"
 #include "epichead/vision/window_image.h"
@@ -58,9 +59,9 @@ std::string to_string(TrackReason reasons);
 struct ModelTrackerOptions {
   TrackMode mode = TrackMode::EpicValidation;
   LineTrackerOptions lines;
-  // Model circles: tracker lines, ellipse RANSAC and arcs (ellipse_tracker.h). The rim side is
-  // not known from a CAO circle, so both sides vote by default.
-  EllipseTrackerOptions ellipses = [] { EllipseTrackerOptions e; e.side = RimSide::Both; return e; }();
+  // Model circles: tracker lines, ellipse RANSAC and arcs (ellipse_tracker.h). Each rim's
+  // object side comes from the faces that meet it (rim_side.h), as a line's from its faces.
+  EllipseTrackerOptions ellipses = [] { EllipseTrackerOptions e; e.side = RimSide::Model; return e; }();
   ValidationOptions validation;
   PoseOptions pose;
   VisibilityOptions visibility;
@@ -79,6 +80,12 @@ struct ModelTrackerOptions {
   // the axis to the prediction and its covariance says the turn is unknown. Found from the
   // model when true; off for every model when false.
   bool free_turn_of_revolution = true;
+  // Model edges that are chords of a model circle (a rim modelled by facets as well as by its
+  // circle) are not tracked as lines while the circle is tracked as an ellipse.
+  bool circles_replace_chords = true;
+  // The first frame (and the first after a reset or a loss) is measured from the start pose
+  // and from a gradient pass's pose, and the better supported start kept (settle()).
+  bool settle = true;
 };
 
 // Per-stage wall time of one frame, milliseconds.
@@ -150,6 +157,7 @@ class ModelTracker {
   Camera camera_;
   ModelTrackerOptions options_;
   Visibility visibility_;
+  RimSides rim_sides_;
   LineTracker lines_;
   EllipseTracker ellipses_;
   TopologyValidator validator_;
@@ -158,6 +166,7 @@ class ModelTracker {
   ValidationResult validation_;
   PoseProblem problem_;
   PoseResult pose_;
+  std::vector<int> chord_of_circle_;          // per model edge: the circle it is a chord of, or -1
   std::vector<int> line_slot_;                // per model edge: its slot in problem_.lines
   std::vector<unsigned char> kept_last_;      // per model edge: found and kept by the pose last frame
   std::vector<unsigned char> kept_now_;

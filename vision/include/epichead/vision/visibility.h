@@ -44,6 +44,9 @@ struct VisibleEllipse {
   double semi_major_px = 0, semi_minor_px = 0;
   double angle_rad = 0;  // of the major axis from the image x axis
   bool facing_camera = true;  // the circle's normal points toward the camera
+  // Which side the object is on (Left = inside, as tracker-line columns run outward); set by
+  // RimSides (rim_side.h), Both until then.
+  ObjectSide side = ObjectSide::Both;
 };
 
 struct VisibilityOptions {
