@@ -161,9 +161,10 @@ class ImuPredictor final : public TrackPredictor {
     // extrapolation says the IMU's prediction had left the object; a run of gated poses that
     // the image supports well (tracked, not degraded) says the filter has drifted. Either way
     // the filter restarts from vision now instead of after reinit_after_gated frames.
-    if (r.verdict == fusion::VisionVerdict::Gated && report.status == vision::TrackStatus::Tracked) ++supported_gated_;
+    const bool strong = strongly_supported(report);
+    if (r.verdict == fusion::VisionVerdict::Gated && strong) ++supported_gated_;
     else supported_gated_ = 0;
-    if (report.used_fallback || supported_gated_ >= kSupportedGatedRestart) {
+    if ((report.used_fallback && strong) || supported_gated_ >= kSupportedGatedRestart) {
       predictor_.reset();
       r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
       supported_gated_ = 0;
@@ -211,6 +212,14 @@ class ImuPredictor final : public TrackPredictor {
 
  private:
   using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  // A pose the image supports well enough to overrule the filter: tracked (no reasons), at
+  // least 80 % of the found features kept, and six constraints or more (a line counts one, an
+  // ellipse two). On box_clutter a wrong pose from 4 of 7 lines was "tracked"; taking it over
+  // the filter's prediction lost the object for good.
+  static bool strongly_supported(const vision::FrameReport& r) {
+    const int found = r.found + 2 * r.ellipses_found, kept = r.inliers + 2 * r.ellipses_found;
+    return r.status == vision::TrackStatus::Tracked && kept >= 6 && kept >= 0.8 * found;
+  }
   static constexpr double kLostResetS = 1.0;
   static constexpr int kSupportedGatedRestart = 3;
   static constexpr int kFitEveryFrames = 10;
@@ -244,6 +253,8 @@ class ImuPredictor final : public TrackPredictor {
     o.imu_time_offset_sigma_s = kEstimatedOffsetSigmaS;
     auto p = fusion::Predictor::create(o);
     if (!p) return;  // options were valid once; only the offset changed
+    // The velocity, biases and gravity learnt so far carry over; only the clock changes.
+    if (const auto motion = predictor_.state()) p->carry_motion(*motion, predictor_.covariance());
     predictor_ = std::move(*p);
     const auto& imu = *imu_;
     next_ = 0;
@@ -285,6 +296,10 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
     options.imu_time_offset_s = imu_time_offset_s.value_or(0.0);
+    // Disagreement is settled here with the pose's support (ImuPredictor::observe): a strongly
+    // supported pose overrules the filter after three gated frames; a weak one only after half
+    // a second of gated frames, when the filter is surely lost too.
+    options.reinit_after_gated = 15;
     // Until the offset is estimated, every pose's time on the IMU clock is that uncertain.
     if (!imu_time_offset_s) options.imu_time_offset_sigma_s = kUnknownOffsetSigmaS;
     auto predictor = fusion::Predictor::create(options);

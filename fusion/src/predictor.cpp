@@ -274,6 +274,16 @@ VisionResult Predictor::initialise(double t_s, const Eigen::Isometry3d& cam_T_ob
   P.diagonal().segment<3>(err::bg).setConstant(sq(options_.initial_gyro_bias_radps));
   P.diagonal().segment<3>(err::ba).setConstant(sq(options_.initial_accel_bias_mps2));
   P.diagonal().segment<2>(err::grav).setConstant(sq(sigma_grav));
+  if (carry_pending_) {
+    x.obj_v_cam = carried_.obj_v_cam;
+    x.gyro_bias_radps = carried_.gyro_bias_radps;
+    x.accel_bias_mps2 = carried_.accel_bias_mps2;
+    x.obj_R_grav = carried_.obj_R_grav;
+    // The motion blocks (velocity .. gravity) with their correlations; none with the new pose.
+    constexpr int first = err::v, n = err::dim - err::v;
+    P.block<n, n>(first, first) = carried_P_.block<n, n>(first, first);
+    carry_pending_ = false;
+  }
 
   // The reading at the exposure time, for the first step after it.
   const std::optional<std::uint64_t> k = find_at_or_before(t_s);
@@ -397,6 +407,12 @@ PredictorStatus Predictor::status(double now_t_s) const {
   s.coasting = initialised_ && options_.mode == PredictorMode::ImuAided &&
                (count_ == 0 || !(now_t_s - status_.newest_imu_t_s <= options_.coast_after_s));
   return s;
+}
+
+void Predictor::carry_motion(const NavState& motion, const ErrorCovariance& covariance) {
+  carried_ = motion;
+  carried_P_ = 0.5 * (covariance + covariance.transpose());
+  carry_pending_ = true;
 }
 
 void Predictor::reset() {

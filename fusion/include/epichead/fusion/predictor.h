@@ -123,6 +123,12 @@ class Predictor {
   PredictorStatus status(double now_t_s) const;
   // Forgets the state (not the buffered samples): the next pose initialises again.
   void reset();
+  // The next initialisation takes velocity, biases and gravity direction (and their variances)
+  // from `motion` instead of the defaults: for a restart on a corrected clock (the camera-IMU
+  // time offset just estimated) while the motion state learnt so far still holds. A restart from
+  // defaults in the middle of a shake initialises gravity from moving readings and the velocity
+  // as unknown, and the translation runs off before vision can pull it back (box_clutter).
+  void carry_motion(const NavState& motion, const ErrorCovariance& covariance);
 
   // The newest filter state (ImuAided), for diagnostics and tests; empty before initialisation.
   std::optional<NavState> state() const;
@@ -173,6 +179,9 @@ class Predictor {
   double last_jump_t_s_ = 0;  // newest sample pushed out of the ring: the anchor is unusable before it
   bool initialised_ = false;
   bool reinit_pending_ = false;
+  bool carry_pending_ = false;  // carry_motion() given for the next initialisation
+  NavState carried_;
+  ErrorCovariance carried_P_ = ErrorCovariance::Zero();
   ConstantVelocityFilter cv_;
   PredictorStatus status_;
 };
