@@ -70,6 +70,8 @@ struct PoseOptions {
   double outlier_sigma = 3.0;        // a feature whose RMS residual exceeds this many scales is an outlier
   double max_condition = 1e10;       // larger condition number of the normal matrix = degenerate
   double convergence_step = 1e-10;   // stop when the update's norm falls below this
+  // Floor of the residual noise the covariance is scaled by, in units of each feature's sigma.
+  double min_noise_sigma = 0.25;
 };
 
 enum class PoseStatus {
