@@ -143,9 +143,17 @@ class ImuPredictor final : public TrackPredictor {
       }
       return;
     }
-    reset_done_ = false;
     last_good_ = report.cam_T_obj;
     last_good_t_s_ = t_s;
+    if (reset_done_ && !strongly_supported(report)) {
+      // Found again after a long loss: the filter restarts only from a pose the image fully
+      // supports. One re-found from a stale prediction can be a wrong lock, and a filter
+      // started on it holds the windows there (can, after its 1 s cover: 14 deg off for good).
+      // Meanwhile the windows follow the vision poses (predict() falls back to last_good_).
+      ++weak_reacquisitions_;
+      return;
+    }
+    reset_done_ = false;
     if (estimator_ && !adopted_) {
       estimator_->add_pose(t_s, report.cam_T_obj);
       // A fit costs about a millisecond: try a few times a second, not every frame.
@@ -204,6 +212,7 @@ class ImuPredictor final : public TrackPredictor {
             {"reinitialisations", c.reinitialisations},
             {"resets_after_loss", resets_},
             {"restarts_from_fallback", fallback_restarts_},
+            {"weak_poses_after_loss", weak_reacquisitions_},
             {"restarts_after_supported_gated", gated_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},
@@ -273,7 +282,7 @@ class ImuPredictor final : public TrackPredictor {
   double last_good_t_s_ = 0, init_t_s_ = 0;
   bool pending_init_ = false, reset_done_ = false;
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
-  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0;
+  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0;
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).
