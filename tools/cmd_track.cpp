@@ -133,6 +133,7 @@ int run_track(const TrackArgs& args) {
   const auto mode = modes.find(args.mode);
   if (mode == modes.end()) return fail(cmd, "--mode must be gradient, epic or epic+validation, got '" + args.mode + "'");
   if (args.imu != "on" && args.imu != "off") return fail(cmd, "--imu must be on or off, got '" + args.imu + "'");
+  if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
   auto seq = Sequence::open(args.seq);
   if (!seq) return fail(cmd, seq.error());
   std::optional<double> offset;
@@ -156,7 +157,6 @@ int run_track(const TrackArgs& args) {
   options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
   options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
   options.lines.epic.ransac.seed = args.ransac_seed;
-  if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
   options.free_turn_of_revolution = args.free_turn == "auto";
   options.settle = args.settle;
   ModelTracker tracker(seq->model(), seq->camera(), options);

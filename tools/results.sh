@@ -10,6 +10,7 @@
 #   --out DIR    where sequences and tracker outputs go (default: out/results)
 #   --no-sweep   leave the jerk sweep out (it simulates 36 short sequences)
 #   --no-heldout leave the held-out evaluation out (it simulates 90 sequences; ~40 min on 2 cores)
+#   --heldout-dir DIR  take the held-out section from an earlier `tools/heldout.sh --out DIR` run
 # Needs jq. ViSP's columns need libvisp-dev (the comparison program builds only with it).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -17,6 +18,7 @@ frames=""
 out="$here/out/results"
 sweep=1
 heldout=1
+heldout_dir=""
 seeds=5
 while (($#)); do
   case "$1" in
@@ -25,7 +27,8 @@ while (($#)); do
     --out) out="$2"; shift 2 ;;
     --no-sweep) sweep=0; shift ;;
     --no-heldout) heldout=0; shift ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --heldout-dir) heldout_dir="$2"; shift 2 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "results: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -45,8 +48,9 @@ bin="$here/build/bin/epichead"
 visp="$here/build/bin/epichead-visp"
 data="$here/../shared/data"
 mkdir -p "$out"
-if ((heldout)); then
-  "$here/tools/heldout.sh" --out "$out/heldout" ${frames:+--frames "$frames"}
+if ((heldout)) && [[ -z "$heldout_dir" ]]; then
+  heldout_dir="$out/heldout"
+  "$here/tools/heldout.sh" --out "$heldout_dir" ${frames:+--frames "$frames"}
 fi
 rows="$out/rows.md"
 : > "$rows"
@@ -202,7 +206,7 @@ fi
   echo "frames per scenario: ${frames:-as the scenario file says}). Do not edit by hand."
   echo
   if ((heldout)); then
-    cat "$out/heldout/section.md"
+    cat "$heldout_dir/section.md"
     echo
     echo "## The scenarios' own seeds"
     echo

@@ -126,6 +126,7 @@ class ImuPredictor final : public TrackPredictor {
     if (pending_init_) {
       const auto r = predictor_.add_vision(init_t_s_, last_good_, vision::initial_pose_covariance());
       pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
+      seeded_by_init_ = !pending_init_;
     }
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
     ++fallbacks_;
@@ -162,6 +163,12 @@ class ImuPredictor final : public TrackPredictor {
         if (const auto e = estimator_->estimate()) return adopt(*e, t_s, report);
       }
     }
+    // The first tracked pose at the start pose's own time replaces it as the seed: applied
+    // after it, it was refused as out of order, the next frame then moved the filter by the
+    // start pose's whole error (a centimetre) in one frame time, and that became a velocity of
+    // ~0.3 m/s: the translation ran off 26 mm per frame (office_pan, development seed 3).
+    if (seeded_by_init_ && t_s <= init_t_s_) predictor_.reset();
+    seeded_by_init_ = false;
     const Matrix6 cov = vision::kTrackedPoseCovarianceInflation * report.covariance;
     auto r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
     if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
@@ -281,6 +288,7 @@ class ImuPredictor final : public TrackPredictor {
   Eigen::Isometry3d last_good_;
   double last_good_t_s_ = 0, init_t_s_ = 0;
   bool pending_init_ = false, reset_done_ = false;
+  bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
   int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0;
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
