@@ -11,6 +11,7 @@
 #   --no-sweep   leave the jerk sweep out (it simulates 36 short sequences)
 #   --no-heldout leave the held-out evaluation out (it simulates 90 sequences; ~40 min on 2 cores)
 #   --heldout-dir DIR  take the held-out section from an earlier `tools/heldout.sh --out DIR` run
+#   --no-visp    do not install libvisp-dev for ViSP's rows
 # Needs jq. ViSP's columns need libvisp-dev (the comparison program builds only with it).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,6 +20,7 @@ out="$here/out/results"
 sweep=1
 heldout=1
 heldout_dir=""
+visp_install=1
 seeds=5
 while (($#)); do
   case "$1" in
@@ -28,14 +30,15 @@ while (($#)); do
     --no-sweep) sweep=0; shift ;;
     --no-heldout) heldout=0; shift ;;
     --heldout-dir) heldout_dir="$2"; shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --no-visp) visp_install=0; shift ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "results: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
 command -v jq >/dev/null || { echo "results: jq is missing (apt-get install jq)" >&2; exit 1; }
 # ViSP's tracker beside ours: install it when we can (root), and configure the build to see it.
 if ! dpkg-query -W -f='${Status}' libvisp-dev 2>/dev/null | grep -q 'install ok installed'; then
-  if [[ $(id -u) -eq 0 ]]; then
+  if ((visp_install)) && [[ $(id -u) -eq 0 ]]; then
     echo "results: installing libvisp-dev for the ViSP comparison"
     DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends libvisp-dev > /dev/null
     [[ -f "$here/build/CMakeCache.txt" ]] && cmake "$here/build" > /dev/null
