@@ -48,7 +48,8 @@ header() {
 
 echo "## Held-out seeds"
 echo
-echo "The rule: **parameters are chosen on development seeds only** ($dev). The held-out seeds"
+echo "The rule: **parameters are chosen on development seeds only** ($dev; also mockup_walk 11"
+echo "and lampshade 13, the seeds issue 19 named, used to diagnose). The held-out seeds"
 echo "($held) were never tuned on; every seed is a new draw of the scene (\`epichead sim SCENARIO"
 echo "--seed N\` varies background, light, material and contrast, camera path and speed, occluders"
 echo "and the object's placement; sim/scenarios/README.md). Success = frames within 5 cm / 5 deg of"
