@@ -24,6 +24,9 @@ inline std::string slurp(const std::string& path) {
   return s.str();
 }
 
+// A path as one shell word (the paths tests make hold no single quote).
+inline std::string shell_quoted(const std::string& s) { return "'" + s + "'"; }
+
 // `epichead <args>`; the captured streams go through files in `scratch`.
 inline ToolRun run_epichead(const TempDir& scratch, const std::string& args) {
   const std::string out = scratch / "stdout.txt", err = scratch / "stderr.txt";

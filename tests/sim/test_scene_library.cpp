@@ -145,6 +145,19 @@ TEST_CASE("mockup_walk: low-contrast plates, a T-truss, three parallel stiffener
   CHECK(visible_edges(*scene) >= 25);
 }
 
+// Facets of a body of revolution: every pair of neighbouring faces is below the crease angle
+// (their shared edge makes no image edge and is not tracked).
+void check_facets_below_crease(const vision::CadModel& m) {
+  const double crease = vision::VisibilityOptions{}.crease_angle_rad;
+  for (const auto& e : m.edges) {
+    if (e.face_count() != 2) continue;
+    const double angle = std::acos(std::clamp(m.faces[static_cast<std::size_t>(e.faces[0])].normal_obj.dot(
+                                                  m.faces[static_cast<std::size_t>(e.faces[1])].normal_obj),
+                                              -1.0, 1.0));
+    CHECK(angle < crease);
+  }
+}
+
 TEST_CASE("lampshade: two rim circles, facets below the crease angle, an open surface and an arm occluder", "[scene_library]") {
   auto scene = sim::make_scene("lampshade");
   REQUIRE(scene);
@@ -154,14 +167,7 @@ TEST_CASE("lampshade: two rim circles, facets below the crease angle, an open su
   CHECK(std::abs(m.circles[1].centre_obj.z() - m.circles[0].centre_obj.z()) > 0.1);
   CHECK_FALSE(m.closed);
   CHECK(m.faces.size() >= 24);
-  const double crease = vision::VisibilityOptions{}.crease_angle_rad;
-  for (const auto& e : m.edges) {
-    if (e.face_count() != 2) continue;
-    const double angle = std::acos(std::clamp(m.faces[static_cast<std::size_t>(e.faces[0])].normal_obj.dot(
-                                                  m.faces[static_cast<std::size_t>(e.faces[1])].normal_obj),
-                                              -1.0, 1.0));
-    CHECK(angle < crease);
-  }
+  check_facets_below_crease(m);
   REQUIRE(scene->occluders.size() == 1);
   REQUIRE(scene->occluder_paths.size() == 1);
   // The arm's default path crosses the line of sight to the shade.
@@ -175,19 +181,6 @@ TEST_CASE("lampshade: two rim circles, facets below the crease angle, an open su
   for (const auto& mat : scene->materials)
     varies = varies || (mat.gradient_per_m_obj.norm() > 0 && mat.gradient_swing > 0 && mat.change_amplitude > 0);
   CHECK(varies);
-}
-
-// Facets of a body of revolution: every pair of neighbouring faces is below the crease angle
-// (their shared edge makes no image edge and is not tracked).
-void check_facets_below_crease(const vision::CadModel& m) {
-  const double crease = vision::VisibilityOptions{}.crease_angle_rad;
-  for (const auto& e : m.edges) {
-    if (e.face_count() != 2) continue;
-    const double angle = std::acos(std::clamp(m.faces[static_cast<std::size_t>(e.faces[0])].normal_obj.dot(
-                                                  m.faces[static_cast<std::size_t>(e.faces[1])].normal_obj),
-                                              -1.0, 1.0));
-    CHECK(angle < crease);
-  }
 }
 
 TEST_CASE("can: 32 facets and two rim circles, 4 cm radius, 12 cm high, a smooth printed render", "[scene_library]") {

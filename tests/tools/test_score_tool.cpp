@@ -34,7 +34,7 @@ using Run = epichead::testing::ToolRun;
 // Runs `epichead score <args>` (arguments already shell-quoted) and captures both streams.
 Run score(const TempDir& tmp, const std::string& args) { return epichead::testing::run_epichead(tmp, "score " + args); }
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+const auto& q = epichead::testing::shell_quoted;
 
 StampedPose pose_at(int frame) {
   StampedPose p;

@@ -18,7 +18,7 @@ using epichead::testing::TempDir;
 
 namespace {
 namespace fs = std::filesystem;
-std::string q(const std::string& s) { return "'" + s + "'"; }
+const auto& q = epichead::testing::shell_quoted;
 }  // namespace
 
 TEST_CASE("track --imu on follows a held-out lampshade, names its free turn's axis and scores with the turn removed") {

@@ -16,7 +16,7 @@ using epichead::testing::TempDir;
 
 namespace {
 namespace fs = std::filesystem;
-std::string q(const std::string& s) { return "'" + s + "'"; }
+const auto& q = epichead::testing::shell_quoted;
 }  // namespace
 
 TEST_CASE("track follows a short simulated mockup_walk with epic+validation and writes every output") {

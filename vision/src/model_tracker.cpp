@@ -97,16 +97,8 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   for (std::size_t e = 0; e < edges; ++e) {
     const Eigen::Vector3d& a = model.vertices[static_cast<std::size_t>(model.edges[e].v0)];
     const Eigen::Vector3d& b = model.vertices[static_cast<std::size_t>(model.edges[e].v1)];
-    for (std::size_t c = 0; c < model.circles.size() && chord_of_circle_[e] < 0; ++c) {
-      const ModelCircle& k = model.circles[c];
-      const Eigen::Vector3d n = k.normal_obj.normalized();
-      const double tol = 1e-3 * k.radius_m + 1e-6;
-      const auto on = [&](const Eigen::Vector3d& p) {
-        const Eigen::Vector3d d = p - k.centre_obj;
-        return std::abs(d.dot(n)) <= tol && std::abs((d - d.dot(n) * n).norm() - k.radius_m) <= tol;
-      };
-      if (on(a) && on(b)) chord_of_circle_[e] = static_cast<int>(c);
-    }
+    for (std::size_t c = 0; c < model.circles.size() && chord_of_circle_[e] < 0; ++c)
+      if (on_circle(model.circles[c], a) && on_circle(model.circles[c], b)) chord_of_circle_[e] = static_cast<int>(c);
   }
   // One slot per model circle, like the lines (a slot without points is ignored).
   problem_.ellipses.resize(model.circles.size());
@@ -304,12 +296,6 @@ Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Is
   const auto support = [](const FrameReport& r) {
     return static_cast<double>(r.inliers + 2 * r.ellipses_found) / std::max(1, r.found + 2 * r.ellipses_found);
   };
-  const auto add_times = [&times](const FrameReport& r) {
-    times.visibility_ms += r.times.visibility_ms;
-    times.epic_ms += r.times.epic_ms;
-    times.validation_ms += r.times.validation_ms;
-    times.pose_ms += r.times.pose_ms;
-  };
   const TrackMode mode = options_.mode;
   if (mode == TrackMode::Gradient) return predicted;  // gradient needs no references
   FrameReport direct, gradient, refined;
@@ -317,14 +303,14 @@ Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Is
   set_mode(TrackMode::Gradient);
   const bool gradient_ok = measure(image, predicted, gradient);
   set_mode(mode);
-  add_times(direct);
-  add_times(gradient);
+  times.add_stages(direct.times);
+  times.add_stages(gradient.times);
   if (!gradient_ok) return predicted;
   // References afresh from the gradient pose's projection.
   lines_.reset();
   ellipses_.reset();
   const bool refined_ok = measure(image, gradient.cam_T_obj, refined);
-  add_times(refined);
+  times.add_stages(refined.times);
   if (refined_ok && (!direct_ok || support(refined) >= support(direct))) return gradient.cam_T_obj;
   lines_.reset();
   ellipses_.reset();
@@ -343,10 +329,7 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   StageTimes settling;
   const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling);
   bool pose_ok = measure(image, start, out);
-  out.times.visibility_ms += settling.visibility_ms;
-  out.times.epic_ms += settling.epic_ms;
-  out.times.validation_ms += settling.validation_ms;
-  out.times.pose_ms += settling.pose_ms;
+  out.times.add_stages(settling);
   if (!pose_ok && fallback) {
     // The second opinion: measured afresh from the other prediction (measure() learns nothing,
     // so the first attempt leaves no trace but its stage times, which add up).

@@ -47,8 +47,7 @@ RimSides::RimSides(const CadModel& model, const Camera& camera) : model_(&model)
       centroid /= static_cast<double>(face.vertices.size());
       for (int vi : face.vertices) {
         const Eigen::Vector3d& p = model.vertices[static_cast<std::size_t>(vi)];
-        const Eigen::Vector3d d = p - circle.centre_obj;
-        if (std::abs(d.dot(n)) > tol || std::abs((d - d.dot(n) * n).norm() - circle.radius_m) > tol) continue;
+        if (!on_circle(circle, p)) continue;
         const Eigen::Vector3d into = centroid - p;
         if (into.norm() <= tol) continue;
         rim.sides.push_back({p, into.normalized(), face.normal_obj});

@@ -39,6 +39,10 @@ struct ModelCircle {
   double radius_m = 0;
 };
 
+// True when p_obj lies on the circle, within a thousandth of its radius (a vertex of the facets
+// that model its rim, written with a few decimals).
+bool on_circle(const ModelCircle& circle, const Eigen::Vector3d& p_obj);
+
 // A cylinder given by two points on its axis and a radius; it is tracked by its silhouette.
 struct ModelCylinder {
   Eigen::Vector3d axis_a_obj = Eigen::Vector3d::Zero();

@@ -91,6 +91,13 @@ struct ModelTrackerOptions {
 // Per-stage wall time of one frame, milliseconds.
 struct StageTimes {
   double visibility_ms = 0, epic_ms = 0, validation_ms = 0, pose_ms = 0, total_ms = 0;
+  // Adds another measurement's stage times (not its total: a frame's total is timed as a whole).
+  void add_stages(const StageTimes& o) {
+    visibility_ms += o.visibility_ms;
+    epic_ms += o.epic_ms;
+    validation_ms += o.validation_ms;
+    pose_ms += o.pose_ms;
+  }
 };
 
 struct FrameReport {
