@@ -250,7 +250,7 @@ std::size_t format_candump_line(const StampedCanFrame& s, std::string_view iface
     --sec;
   }
   p += std::snprintf(p, 40, "(%010lld.%06lld) ", static_cast<long long>(sec), static_cast<long long>(usec));
-  const std::size_t n_iface = std::min<std::size_t>(iface.size(), 15);
+  const std::size_t n_iface = std::min(iface.size(), kCandumpMaxIface);
   std::memcpy(p, iface.data(), n_iface);
   p += n_iface;
   *p++ = ' ';

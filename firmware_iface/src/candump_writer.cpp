@@ -1,6 +1,7 @@
 #include "epichead/firmware_iface/candump_writer.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 
@@ -32,6 +33,9 @@ std::expected<void, std::string> CandumpWriter::write(const StampedCanFrame& fra
   if (!file_) return std::unexpected(path_ + ": writer is closed");
   if (iface.empty() || iface.find_first_of(" \t\r\n") != std::string_view::npos)
     return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is empty or has blanks");
+  if (iface.size() > kCandumpMaxIface)
+    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is longer than " +
+                           std::to_string(kCandumpMaxIface) + " characters");
   char line[kCandumpMaxLine];
   const std::size_t n = format_candump_line(frame, iface, line, direction);
   if (std::fwrite(line, 1, n, file_) != n) return std::unexpected(path_ + ": write error (" + std::strerror(errno) + ")");
