@@ -61,7 +61,9 @@ inline constexpr std::size_t kCandumpMaxLine =
     candump_detail::longest_stamp() + kCandumpMaxIface + 1 + 8 + 2 + 1 + 2 * kCanFdMaxData + 2 + 1;
 
 // Formats a frame in the log format (with '\n') into buf (kCandumpMaxLine bytes at least);
-// returns the length. A Direction other than Unknown is appended as " R" / " T".
+// returns the length. A Direction other than Unknown is appended as " R" / " T". The frame
+// should be possible (impossible_frame_reason: CandumpWriter checks): an impossible one is
+// written as best it can be and does not read back the same.
 std::size_t format_candump_line(const StampedCanFrame& frame, std::string_view iface, char* buf,
                                 CanDirection direction = CanDirection::Unknown);
 
