@@ -83,3 +83,16 @@ TEST_CASE("Binary data and text OpenCV cannot parse are errors with the file nam
   CHECK_THAT(load_error("%YAML:1.0\n---\n- 1\n"), Catch::Contains("cam.yaml: "));
   CHECK_THAT(load_error("%YAML:1.0\n---\ncamera_matrix: { \"\": 2}\n"), Catch::Contains("empty key"));
 }
+
+TEST_CASE("A calibration model the reader does not support is an error, never read as another") {
+  // What cv::fisheye calibration writes: 4 coefficients that are not k1 k2 p1 p2.
+  CHECK_THAT(load_error(edited("image_width: 160", "fisheye_model: 1\nimage_width: 160")),
+             Catch::Contains("fisheye calibration (fisheye_model) is not supported"));
+  CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: equidistant\nimage_width: 160")),
+             Catch::Contains("distortion_model 'equidistant' is not supported"));
+  CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: rational_polynomial\nimage_width: 160")),
+             Catch::Contains("distortion_model 'rational_polynomial' is not supported"));
+  epichead::testing::TempDir dir("epichead_test_camera_bad");
+  CHECK(Camera::load(dir.write("a.yaml", edited("image_width: 160", "fisheye_model: 0\nimage_width: 160"))).has_value());
+  CHECK(Camera::load(dir.write("b.yaml", edited("image_width: 160", "distortion_model: plumb_bob\nimage_width: 160"))).has_value());
+}

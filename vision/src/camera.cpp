@@ -85,7 +85,24 @@ std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const
   return m;
 }
 
+// A calibration for another camera model than the pinhole with k1 k2 p1 p2 k3 is an error: read
+// as this one, it would project pixels off without a word.
+std::expected<void, std::string> check_model(const cv::FileStorage& fs, const std::string& path) {
+  const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes
+  if (!fisheye.empty() && !fisheye.isNone() && !(fisheye.isInt() && static_cast<int>(fisheye) == 0))
+    return Error(path + ": a fisheye calibration (fisheye_model) is not supported: only the pinhole model with "
+                        "distortion k1 k2 p1 p2 k3");
+  const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
+  if (!model.empty() && !model.isNone()) {
+    const std::string name = model.isString() ? model.string() : std::string("(not a name)");
+    if (name != "plumb_bob")
+      return Error(path + ": distortion_model '" + name + "' is not supported: only plumb_bob (k1 k2 p1 p2 k3)");
+  }
+  return {};
+}
+
 std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path) {
+  if (auto ok = check_model(fs, path); !ok) return Error(ok.error());
   auto width = read_size(fs, path, "image_width");
   if (!width) return Error(width.error());
   auto height = read_size(fs, path, "image_height");
