@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "command.h"
+#include "printable.h"
 #include "epichead/firmware_iface/version.h"
 
 namespace epichead::tools {
@@ -19,7 +20,8 @@ CommandRegistration::CommandRegistration(std::string name, std::string summary, 
 }
 
 int fail(const std::string& command, const std::string& reason) {
-  std::cerr << "epichead " << command << ": " << reason << "\n";
+  // The reason holds file names and text from files: shown escaped (printable.h).
+  std::cerr << "epichead " << command << ": " << printable(reason) << "\n";
   return 1;
 }
 
@@ -49,8 +51,7 @@ int main(int argc, char** argv) {
       try {
         return action();
       } catch (const std::exception& e) {
-        std::cerr << "epichead " << sub->get_name() << ": " << e.what() << "\n";
-        return 1;
+        return fail(sub->get_name(), e.what());
       }
     }
   }
