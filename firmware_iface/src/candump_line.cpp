@@ -124,8 +124,9 @@ CandumpParse parse_log_frame(Cursor& c, CandumpRecord& out) {
     f.len = 0;
     if (!c.done() && *c.p >= '0' && *c.p <= '8') f.len = static_cast<std::uint8_t>(*c.p++ - '0');
     if (c.peek() == '_') {  // raw DLC 9..F after a length of 8
+      if (f.len != 8 || c.p + 1 >= c.end || hex(c.p[1]) < 9)
+        return bad(c, "'_' raw DLC needs a length of 8 and a DLC 9..F");
       c.p += 2;
-      if (c.p > c.end) return bad(c, "'_' must be followed by a DLC digit");
     }
     return {CandumpLineKind::Frame, "", 0};
   }
@@ -228,6 +229,10 @@ CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out) {
   c.p = frame_start;
   const CandumpParse r = log_form ? parse_log_frame(c, out) : parse_default_frame(c, out);
   if (r.kind != CandumpLineKind::Frame) return r;
+  if (const char* why = impossible_frame_reason(out.frame.frame)) {
+    c.p = frame_start;
+    return bad(c, why);
+  }
   c.skip_spaces();
   if (!c.done() && log_form) {
     if (*c.p == 'R') out.direction = CanDirection::Received;
@@ -250,7 +255,7 @@ std::size_t format_candump_line(const StampedCanFrame& s, std::string_view iface
     --sec;
   }
   p += std::snprintf(p, 40, "(%010lld.%06lld) ", static_cast<long long>(sec), static_cast<long long>(usec));
-  const std::size_t n_iface = std::min<std::size_t>(iface.size(), 15);
+  const std::size_t n_iface = std::min(iface.size(), kCandumpMaxIface);
   std::memcpy(p, iface.data(), n_iface);
   p += n_iface;
   *p++ = ' ';

@@ -1,10 +1,22 @@
 #include "epichead/firmware_iface/candump_writer.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 
 namespace epichead::firmware_iface {
+namespace {
+
+constexpr std::int64_t kMaxStampUs = 1'000'000'000'000LL * 1'000'000;
+
+std::string hex_id(std::uint32_t id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%X", static_cast<unsigned>(id));
+  return buf;
+}
+
+}  // namespace
 
 std::expected<CandumpWriter, std::string> CandumpWriter::open(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
@@ -32,6 +44,15 @@ std::expected<void, std::string> CandumpWriter::write(const StampedCanFrame& fra
   if (!file_) return std::unexpected(path_ + ": writer is closed");
   if (iface.empty() || iface.find_first_of(" \t\r\n") != std::string_view::npos)
     return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is empty or has blanks");
+  if (iface.size() > kCandumpMaxIface)
+    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is longer than " +
+                           std::to_string(kCandumpMaxIface) + " characters");
+  if (const char* why = impossible_frame_reason(frame.frame))
+    return std::unexpected(path_ + ": cannot record CAN id 0x" + hex_id(frame.frame.id) + ": " + why);
+  // The reader takes (seconds.microseconds) with 1 to 12 digits of seconds, none negative.
+  if (frame.stamp_us < 0 || frame.stamp_us >= kMaxStampUs)
+    return std::unexpected(path_ + ": cannot record a frame stamped " + std::to_string(frame.stamp_us) +
+                           " us: a candump stamp is 0 to 10^12 s");
   char line[kCandumpMaxLine];
   const std::size_t n = format_candump_line(frame, iface, line, direction);
   if (std::fwrite(line, 1, n, file_) != n) return std::unexpected(path_ + ": write error (" + std::strerror(errno) + ")");

@@ -167,9 +167,12 @@ TEST_CASE("Mutated and random lines never crash the parser and never yield impos
       const auto& f = r.frame.frame;
       REQUIRE(f.len <= (f.fd() ? 64 : 8));
       REQUIRE(f.id <= (f.extended() || f.error() ? 0x1FFFFFFFu : 0x7FFu));
+      REQUIRE(impossible_frame_reason(f) == nullptr);
     } else if (p.kind == CandumpLineKind::Malformed) {
       ++malformed;
       REQUIRE(p.reason[0] != '\0');
+      REQUIRE(p.column >= 1);
+      REQUIRE(static_cast<std::size_t>(p.column) <= line.size() + 1);
     }
   }
   CHECK(frames > 100);     // some mutations stay valid

@@ -40,6 +40,12 @@ struct CanFrame {
   bool fd() const { return has(flags, CanFlags::Fd); }
 };
 
+// Why no CAN bus can carry this frame (a string literal), or nullptr if one can: an FD or
+// error frame marked remote, an error frame that is FD or has an 11/29-bit id format, BRS or
+// ESI on a classic frame, an id wider than its format, a length no DLC gives. The candump
+// reader rejects these and the writer refuses them, so what is written reads back the same.
+const char* impossible_frame_reason(const CanFrame& frame);
+
 // A frame with the time it was seen on the bus (kernel receive time, log time or simulated
 // time), in integer microseconds since the clock's epoch: exact for a log's sec.usec stamps.
 struct StampedCanFrame {

@@ -40,11 +40,30 @@ struct CandumpParse {
 // Parses one line (without its '\n'). On Frame, `out` holds the record.
 CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out);
 
-// The longest line format_candump_line writes (FD, 64 bytes, 15-char iface name).
-inline constexpr std::size_t kCandumpMaxLine = 160;
+// The longest interface name Linux allows (IFNAMSIZ - 1); format_candump_line cuts longer ones.
+inline constexpr std::size_t kCandumpMaxIface = 15;
+
+namespace candump_detail {
+// Characters of "(sec.usec) " for the stamp with the longest seconds, negative included.
+constexpr std::size_t longest_stamp() {
+  constexpr std::int64_t kMinUs = INT64_MIN;
+  std::int64_t sec = kMinUs / 1'000'000 - 1;  // floor division, as format_candump_line does
+  std::size_t digits = 0;
+  for (; sec != 0; sec /= 10) ++digits;
+  return 1 + 1 + (digits < 10 ? 10 : digits) + 1 + 6 + 1 + 1;  // '(' '-' sec '.' usec ')' ' '
+}
+}  // namespace candump_detail
+
+// The longest line format_candump_line writes, with its '\n': the longest stamp, the longest
+// interface name and a space, a 29-bit id, "##", the FD flags digit, 64 data bytes in hex,
+// then " R" / " T" and the newline.
+inline constexpr std::size_t kCandumpMaxLine =
+    candump_detail::longest_stamp() + kCandumpMaxIface + 1 + 8 + 2 + 1 + 2 * kCanFdMaxData + 2 + 1;
 
 // Formats a frame in the log format (with '\n') into buf (kCandumpMaxLine bytes at least);
-// returns the length. A Direction other than Unknown is appended as " R" / " T".
+// returns the length. A Direction other than Unknown is appended as " R" / " T". The frame
+// should be possible (impossible_frame_reason: CandumpWriter checks): an impossible one is
+// written as best it can be and does not read back the same.
 std::size_t format_candump_line(const StampedCanFrame& frame, std::string_view iface, char* buf,
                                 CanDirection direction = CanDirection::Unknown);
 
