@@ -1,5 +1,6 @@
 #include "run_config.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -8,6 +9,27 @@
 namespace epichead::tools {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// A number field of an object, or `fallback` when the key is absent. Checked before nlohmann
+// converts it: its get<int>() of a double out of int's range (a "width": 1e300) is undefined
+// behaviour, and it would silently truncate 640.5. The error names the field and the range.
+std::expected<double, std::string> number(const nlohmann::json& object, const char* object_name, const char* key,
+                                          double fallback, double lo, double hi, bool whole) {
+  if (!object.contains(key)) return fallback;
+  const nlohmann::json& v = object[key];
+  const std::string name = std::string(object_name) + "." + key;
+  char range[96];
+  std::snprintf(range, sizeof range, "a %s from %g to %g", whole ? "whole number" : "number", lo, hi);
+  if (!v.is_number()) return std::unexpected(name + " must be " + std::string(range));
+  const double x = v.get<double>();
+  if (!(x >= lo && x <= hi) || (whole && x != static_cast<double>(static_cast<long long>(x))))
+    return std::unexpected(name + " must be " + range + ", got " + v.dump());
+  return x;
+}
+
+}  // namespace
 
 std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
   std::ifstream in(path);
@@ -29,18 +51,31 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
     c.init_pose = resolve(j["init_pose"].get<std::string>());
     c.out = resolve(j.value("out", c.out));
     c.mode = j.value("mode", c.mode);
+    auto fail = [&](const std::string& what) { return std::unexpected(path + ": " + what); };
     if (j.contains("camera")) {
       const auto& cam = j["camera"];
+      if (!cam.is_object()) return fail("camera must be an object");
       c.camera.device = cam.value("device", c.camera.device);
-      c.camera.width = cam.value("width", c.camera.width);
-      c.camera.height = cam.value("height", c.camera.height);
-      c.camera.frame_rate_hz = cam.value("fps", c.camera.frame_rate_hz);
+      const auto width = number(cam, "camera", "width", c.camera.width, 1, 65535, true);
+      if (!width) return fail(width.error());
+      const auto height = number(cam, "camera", "height", c.camera.height, 1, 65535, true);
+      if (!height) return fail(height.error());
+      const auto fps = number(cam, "camera", "fps", c.camera.frame_rate_hz, 0, 1e6, false);
+      if (!fps) return fail(fps.error());
+      c.camera.width = static_cast<int>(*width);
+      c.camera.height = static_cast<int>(*height);
+      c.camera.frame_rate_hz = *fps;
     }
     if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
     if (j.contains("head")) {
       const auto& h = j["head"];
-      c.backlash.pan_rad = h.value("pan_backlash_rad", c.backlash.pan_rad);
-      c.backlash.tilt_rad = h.value("tilt_backlash_rad", c.backlash.tilt_rad);
+      if (!h.is_object()) return fail("head must be an object");
+      const auto pan = number(h, "head", "pan_backlash_rad", c.backlash.pan_rad, 0, 1, false);
+      if (!pan) return fail(pan.error());
+      const auto tilt = number(h, "head", "tilt_backlash_rad", c.backlash.tilt_rad, 0, 1, false);
+      if (!tilt) return fail(tilt.error());
+      c.backlash.pan_rad = *pan;
+      c.backlash.tilt_rad = *tilt;
     }
   } catch (const nlohmann::json::exception& e) {
     return std::unexpected(path + ": wrong type: " + e.what());
