@@ -13,6 +13,7 @@
 #include <string>
 
 #include "command.h"
+#include "printable.h"
 #include "epichead/firmware_iface/candump_reader.h"
 #include "epichead/firmware_iface/imu_protocol.h"
 #include "replay/log_analysis.h"
@@ -66,7 +67,7 @@ int run(const Options& o) {
                               " malformed lines; expected candump log lines such as '(1436509052.249713) can0 123#DEADBEEF')");
 
   replay::ReadSummary read{o.log, reader->lines(), reader->malformed(), {}};
-  for (const auto& e : reader->first_errors()) read.first_errors.push_back(e.message(o.log));
+  for (const auto& e : reader->first_errors()) read.first_errors.push_back(printable(e.message(o.log)));
   if (!o.plot_dir.empty()) {
     const std::string title = std::filesystem::path(o.log).filename().string();
     auto written = replay::write_plots(analyzer, o.plot_dir, title);

@@ -50,6 +50,12 @@ int run_onboard(const std::string& config_path, double seconds) {
   if (!bus) return fail(cmd, bus.error());
   auto camera = hw::V4l2Camera::open(config->camera);
   if (!camera) return fail(cmd, camera.error());
+  // The driver may choose another size than the one asked for: it must be the calibration's.
+  if ((*camera)->format().width != camera_model->width_px() || (*camera)->format().height != camera_model->height_px())
+    return fail(cmd, config->camera.device + " gives " + std::to_string((*camera)->format().width) + "x" +
+                         std::to_string((*camera)->format().height) + " frames but " + config->calibration +
+                         " is a calibration for " + std::to_string(camera_model->width_px()) + "x" +
+                         std::to_string(camera_model->height_px()));
   hw::MonotonicClock clock;
   head::OnboardPorts ports;
   ports.clock = &clock;

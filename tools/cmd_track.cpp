@@ -19,6 +19,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "command.h"
+#include "printable.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/overlay.h"
@@ -311,7 +312,7 @@ int run_track(const TrackArgs& args) {
               percentile(track_ms, 0.99));
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays,
               args.video && video_note.empty() ? (" and " + video_path).c_str() : "");
-  if (!video_note.empty()) std::fprintf(stderr, "track: %s\n", video_note.c_str());
+  if (!video_note.empty()) std::fprintf(stderr, "track: %s\n", printable(video_note).c_str());
   return 0;
 }
 

@@ -30,7 +30,13 @@ struct CommandRegistration {
   CommandRegistration(std::string name, std::string summary, CommandSetup setup);
 };
 
-// Prints "epichead <command>: <reason>" on stderr and returns the exit code for bad input.
+// Exit codes: 0 done, 1 a runtime error (bad input file, device, ...), 2 a command line that
+// does not parse (with the usage line on stderr).
+inline constexpr int kRuntimeErrorExit = 1;
+inline constexpr int kUsageExit = 2;
+
+// Prints "epichead <command>: <reason>" on stderr (escaped: printable.h) and returns
+// kRuntimeErrorExit.
 int fail(const std::string& command, const std::string& reason);
 
 }  // namespace epichead::tools

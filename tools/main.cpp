@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "command.h"
+#include "printable.h"
 #include "epichead/firmware_iface/version.h"
 
 namespace epichead::tools {
@@ -19,10 +20,39 @@ CommandRegistration::CommandRegistration(std::string name, std::string summary, 
 }
 
 int fail(const std::string& command, const std::string& reason) {
-  std::cerr << "epichead " << command << ": " << reason << "\n";
-  return 1;
+  // The reason holds file names and text from files: shown escaped (printable.h).
+  std::cerr << "epichead " << command << ": " << printable(reason) << "\n";
+  return kRuntimeErrorExit;
 }
 
+namespace {
+
+// A command line that does not parse: one line saying why, the usage line of the command (or
+// of the program), exit code 2 (the convention of getopt tools; CLI11's own codes are 105-109).
+int usage_error(const CLI::App& app, const std::vector<std::pair<CLI::App*, CommandAction>>& actions, int argc,
+                char** argv, const std::string& what) {
+  const CLI::App* command = nullptr;
+  for (const auto& [sub, action] : actions)
+    if (sub->parsed()) command = sub;
+  CLI::Formatter formatter;
+  if (!command && argc > 1 && argv[1][0] != '-') {
+    // The first word is not an option and no command took it: it is a command we do not have.
+    std::string names;
+    for (const auto& [sub, action] : actions) names += (names.empty() ? "" : ", ") + sub->get_name();
+    std::cerr << "epichead: unknown command '" << printable(argv[1]) << "' (commands: " << names << ")\n"
+              << formatter.make_usage(&app, "epichead");
+  } else if (command) {
+    std::cerr << "epichead " << command->get_name() << ": " << printable(what) << "\n"
+              << formatter.make_usage(command, "epichead " + command->get_name())
+              << "Run 'epichead " << command->get_name() << " --help' for the options.\n";
+  } else {
+    std::cerr << "epichead: " << printable(what) << "\n" << formatter.make_usage(&app, "epichead")
+              << "Run 'epichead --help' for the commands.\n";
+  }
+  return kUsageExit;
+}
+
+}  // namespace
 }  // namespace epichead::tools
 
 int main(int argc, char** argv) {
@@ -41,18 +71,23 @@ int main(int argc, char** argv) {
   }
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return usage_error(app, actions, argc, argv, e.what());
   }
   for (auto& [sub, action] : actions) {
     if (sub->parsed()) {
       try {
         return action();
       } catch (const std::exception& e) {
-        std::cerr << "epichead " << sub->get_name() << ": " << e.what() << "\n";
-        return 1;
+        return fail(sub->get_name(), e.what());
       }
     }
   }
-  return 1;
+  return kRuntimeErrorExit;
 }

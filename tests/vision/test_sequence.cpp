@@ -287,3 +287,29 @@ TEST_CASE("write_frames_csv and write_imu_csv refuse what they cannot write") {
   REQUIRE(empty.has_value());
   CHECK(empty->empty());
 }
+
+TEST_CASE("frames of another size than the calibration are an error naming the file and both sizes") {
+  TempDir dir;
+  write_image_sequence(dir, 2);
+  // A 320x240 calibration for 640x480 frames tracked with exit 0 and most frames lost.
+  REQUIRE(Camera(320, 240, Intrinsics{400, 400, 159.5, 119.5}).save(dir.str() + "/camera.yaml").has_value());
+  REQUIRE(cv::imwrite(dir.str() + "/frames/000000.png", cv::Mat(480, 640, CV_8UC3, cv::Scalar(1, 2, 3))));
+  auto seq = Sequence::open(dir.str());
+  REQUIRE(seq.has_value());
+  auto bad = seq->read_frame(0);
+  REQUIRE_FALSE(bad.has_value());
+  CHECK_THAT(bad.error(), Catch::Contains("frames/000000.png") && Catch::Contains("640x480") &&
+                              Catch::Contains("camera.yaml is a calibration for 320x240"));
+}
+
+TEST_CASE("video frames of another size than the calibration are an error naming the video and both sizes") {
+  TempDir dir;
+  for (const char* name : {"model.cao", "init.csv", "video.mp4"}) fs::copy_file(kShared + "/teabox/" + name, dir.path / name);
+  REQUIRE(Camera(320, 240, Intrinsics{400, 400, 159.5, 119.5}).save(dir.str() + "/camera.yaml").has_value());
+  auto seq = Sequence::open(dir.str());
+  REQUIRE(seq.has_value());
+  auto bad = seq->read_frame(0);
+  REQUIRE_FALSE(bad.has_value());
+  CHECK_THAT(bad.error(), Catch::Contains("video.mp4 frame 0") && Catch::Contains("640x480") &&
+                              Catch::Contains("calibration for 320x240"));
+}

@@ -6,9 +6,12 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <string_view>
 
 #include <Eigen/LU>
 #include <opencv2/core.hpp>
+
+#include "camera_yaml_precheck.h"
 
 namespace epichead::vision {
 namespace {
@@ -29,28 +32,77 @@ std::expected<int, std::string> read_size(const cv::FileStorage& fs, const std::
   return static_cast<int>(value);
 }
 
-// Reads an opencv-matrix field as CV_64F.
+// The largest matrix side a camera YAML has a use for (distortion: 14 values at most).
+constexpr int kMaxMatrixSide = 16;
+
+// Reads a whole-number matrix dimension (rows, cols) in 0..kMaxMatrixSide.
+std::expected<int, std::string> read_dimension(const cv::FileNode& matrix, const std::string& path, const char* field,
+                                               const char* dimension) {
+  const cv::FileNode node = matrix[dimension];
+  const std::string where = path + ": " + field + "." + dimension;
+  if (node.empty() || node.isNone()) return Error(path + ": " + field + " is not a valid opencv-matrix (no " + dimension + ")");
+  if (!node.isInt()) return Error(where + " must be a whole number");
+  const int value = static_cast<int>(node);
+  if (value < 0 || value > kMaxMatrixSide)
+    return Error(where + " must be 0.." + std::to_string(kMaxMatrixSide) + ", got " + std::to_string(value));
+  return value;
+}
+
+// Reads an opencv-matrix field (rows, cols, dt, data) as CV_64F. Decoded here rather than by
+// OpenCV's `node >> mat`, which allocates rows x cols x element size before it looks at the
+// data: a one-character typo in rows or cols asks it for tens of gigabytes.
 std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const std::string& path, const char* field) {
   const cv::FileNode node = fs[field];
   if (node.empty() || node.isNone()) return Error(path + ": missing field '" + field + "'");
   if (!node.isMap()) return Error(path + ": " + field + " must be an opencv-matrix (rows, cols, dt, data)");
-  cv::Mat m;
-  try {
-    node >> m;
-  } catch (const cv::Exception& e) {
-    return Error(path + ": " + field + " is not a valid opencv-matrix: " + e.err);
+  auto rows = read_dimension(node, path, field, "rows");
+  if (!rows) return Error(rows.error());
+  auto cols = read_dimension(node, path, field, "cols");
+  if (!cols) return Error(cols.error());
+  const cv::FileNode dt = node["dt"];
+  if (!dt.isString()) return Error(path + ": " + field + ".dt must be an element type such as d");
+  const std::string type = dt.string();
+  if (type.size() != 1 || std::string_view("ucwsifdh").find(type[0]) == std::string_view::npos)
+    return Error(path + ": " + field + " must have one channel of a number type (dt: d), got dt: " + type);
+  const int n = *rows * *cols;
+  const cv::FileNode data = node["data"];
+  if (n == 0 && (data.empty() || data.isNone() || (data.isSeq() && data.size() == 0))) return cv::Mat();
+  if (!data.isSeq()) return Error(path + ": " + field + ".data must be a list [ ... ] of " + std::to_string(n) + " numbers");
+  if (static_cast<int>(data.size()) != n)
+    return Error(path + ": " + field + ".data has " + std::to_string(data.size()) + " values, rows x cols is " +
+                 std::to_string(*rows) + "x" + std::to_string(*cols));
+  cv::Mat m(*rows, *cols, CV_64F);
+  int i = 0;
+  for (const cv::FileNode& value : data) {
+    const int r = i / *cols, c = i % *cols;
+    ++i;
+    if (!value.isInt() && !value.isReal())
+      return Error(path + ": " + field + ".data value " + std::to_string(i) + " is not a number");
+    m.at<double>(r, c) = value.real();
+    if (!std::isfinite(m.at<double>(r, c)))
+      return Error(path + ": " + field + " has a non-finite value at (" + std::to_string(r) + "," + std::to_string(c) + ")");
   }
-  if (m.empty() && node["rows"].empty()) return Error(path + ": " + field + " is not a valid opencv-matrix (no rows)");
-  if (m.channels() != 1) return Error(path + ": " + field + " must have one channel");
-  if (!m.empty()) m.convertTo(m, CV_64F);
-  for (int r = 0; r < m.rows; ++r)
-    for (int c = 0; c < m.cols; ++c)
-      if (!std::isfinite(m.at<double>(r, c)))
-        return Error(path + ": " + field + " has a non-finite value at (" + std::to_string(r) + "," + std::to_string(c) + ")");
   return m;
 }
 
+// A calibration for another camera model than the pinhole with k1 k2 p1 p2 k3 is an error: read
+// as this one, it would project pixels off without a word.
+std::expected<void, std::string> check_model(const cv::FileStorage& fs, const std::string& path) {
+  const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes
+  if (!fisheye.empty() && !fisheye.isNone() && !(fisheye.isInt() && static_cast<int>(fisheye) == 0))
+    return Error(path + ": a fisheye calibration (fisheye_model) is not supported: only the pinhole model with "
+                        "distortion k1 k2 p1 p2 k3");
+  const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
+  if (!model.empty() && !model.isNone()) {
+    const std::string name = model.isString() ? model.string() : std::string("(not a name)");
+    if (name != "plumb_bob")
+      return Error(path + ": distortion_model '" + name + "' is not supported: only plumb_bob (k1 k2 p1 p2 k3)");
+  }
+  return {};
+}
+
 std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path) {
+  if (auto ok = check_model(fs, path); !ok) return Error(ok.error());
   auto width = read_size(fs, path, "image_width");
   if (!width) return Error(width.error());
   auto height = read_size(fs, path, "image_height");
@@ -100,23 +152,32 @@ Camera::Camera(int width_px, int height_px, const Intrinsics& k, const Distortio
 }
 
 std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
-  std::ifstream probe(yaml_path, std::ios::binary);
   std::error_code ec;
-  if (!probe || !std::filesystem::is_regular_file(yaml_path, ec)) return Error(yaml_path + ": cannot open (no such file)");
-  std::string start(9, '\0');
-  probe.read(start.data(), static_cast<std::streamsize>(start.size()));
-  start.resize(static_cast<std::size_t>(probe.gcount()));
-  if (start.empty()) return Error(yaml_path + ": empty file (expected OpenCV FileStorage YAML)");
+  if (!std::filesystem::is_regular_file(yaml_path, ec)) return Error(yaml_path + ": cannot open (no such file)");
+  const auto size = std::filesystem::file_size(yaml_path, ec);
+  if (ec) return Error(yaml_path + ": cannot open (" + ec.message() + ")");
+  if (size > kCameraYamlMaxBytes)
+    return Error(yaml_path + ": " + std::to_string(size) + " bytes is larger than any camera calibration (1 MiB at most)");
+  std::ifstream in(yaml_path, std::ios::binary);
+  if (!in) return Error(yaml_path + ": cannot open");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.empty()) return Error(yaml_path + ": empty file (expected OpenCV FileStorage YAML)");
+  if (auto ok = precheck_camera_yaml(text); !ok) return Error(yaml_path + ": not a camera YAML: " + ok.error());
   // OpenCV's YAML reader insists on the directive line; saying so beats its "Input file is invalid".
-  const std::string hint = start.starts_with("%YAML") ? "" : "; it must start with %YAML:1.0";
+  const std::string hint = text.starts_with("%YAML") ? "" : "; it must start with %YAML:1.0";
   try {
-    cv::FileStorage fs(yaml_path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) return Error(yaml_path + ": cannot open as OpenCV FileStorage YAML" + hint);
     if (!fs.root().isMap()) return Error(yaml_path + ": not an OpenCV FileStorage YAML mapping");
     return load_from(fs, yaml_path);
   } catch (const cv::Exception& e) {
     // OpenCV's parser throws on text that is not YAML.
     return Error(yaml_path + ": not OpenCV FileStorage YAML (" + e.err + hint + ")");
+  } catch (const std::exception& e) {
+    // OpenCV's parser also lets standard exceptions out (std::length_error, std::bad_alloc).
+    return Error(yaml_path + ": not OpenCV FileStorage YAML (the parser failed: " + e.what() + hint + ")");
   }
 }
 

@@ -141,6 +141,9 @@ bool parse_integer(std::string_view s, long long& value, bool& overflow) {
   return ec == std::errc{} || overflow;
 }
 
+// How errors state the bound on coordinates, radii and translations.
+const std::string kExtentText = "the 1e6 m a physical model can have";
+
 // A finite decimal number taking the whole of `s`.
 bool parse_number(std::string_view s, double& value) {
   if (s.starts_with('+')) s.remove_prefix(1);
@@ -279,6 +282,7 @@ class Parser {
     Token t;
     auto r = read_number([] { return std::string("radius"); }, t);
     if (r && !(*r > 0)) return fail(t, "radius must be > 0, got " + shown(t));
+    if (r && *r > kMaxModelExtentM) return fail(t, "radius " + shown(t) + " is beyond " + kExtentText);
     return r;
   }
 
@@ -338,6 +342,9 @@ class Parser {
                            std::string(param.substr(0, 60)) + "'");
       }
     }
+    if (trans.cwiseAbs().maxCoeff() > kMaxModelExtentM)
+      return fail(t, "load() translation t=[" + std::to_string(trans.x()) + ";" + std::to_string(trans.y()) + ";" +
+                         std::to_string(trans.z()) + "] is beyond " + kExtentText);
     Eigen::Isometry3d file_T_child = Eigen::Isometry3d::Identity();
     const double angle = tu.norm();
     if (angle > 0) file_T_child.linear() = Eigen::AngleAxisd(angle, tu / angle).toRotationMatrix();
@@ -407,6 +414,7 @@ class Parser {
         const auto what = [&] { return std::string("coordinate ") + "XYZ"[c] + " of point " + std::to_string(k); };
         auto v = read_number(what, t);
         if (!v) return std::unexpected(v.error());
+        if (std::abs(*v) > kMaxModelExtentM) return fail(t, what() + " " + shown(t) + " is beyond " + kExtentText);
         p[c] = *v;
       }
       for (int c = 0; c < (version_ == 2 ? 2 : 0); ++c) {
@@ -414,7 +422,10 @@ class Parser {
           return std::unexpected(v.error());
         }
       }
-      acc_.raw.vertices.push_back(model_T_file_ * p);
+      const Eigen::Vector3d p_model = model_T_file_ * p;
+      if (!(p_model.cwiseAbs().maxCoeff() <= kMaxModelExtentM))
+        return fail(t, "point " + std::to_string(k) + " lies beyond " + kExtentText + " once moved by the load() transforms");
+      acc_.raw.vertices.push_back(p_model);
     }
     points_ = static_cast<std::size_t>(*n);
     return {};

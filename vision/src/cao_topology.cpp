@@ -27,6 +27,8 @@ constexpr long long kEarClipBudget = 20'000'000;
 constexpr double kDegenerateRatio = 1e-9;
 // Vertices farther than this fraction of the perimeter from the face plane: not planar.
 constexpr double kPlanarityRatio = 1e-4;
+// How errors state the bound on coordinates and radii (cao_model.h).
+const std::string kExtentText = "the 1e6 m a physical model can have";
 
 std::uint64_t edge_key(int a, int b) {
   const auto lo = static_cast<std::uint32_t>(std::min(a, b));
@@ -63,9 +65,14 @@ std::unexpected<std::string> index_error(const std::string& who, long long index
 
 std::expected<void, std::string> validate(const RawModel& raw, const Namer& namer) {
   const std::size_t nv = raw.vertices.size();
+  // Within the physical bound, every difference, length and distance below stays finite.
+  const auto beyond = [](const Eigen::Vector3d& v) { return !(v.cwiseAbs().maxCoeff() <= kMaxModelExtentM); };
   for (std::size_t i = 0; i < nv; ++i) {
     if (!finite(raw.vertices[i])) {
       return std::unexpected(namer.model() + ": point " + std::to_string(i) + " is not finite");
+    }
+    if (beyond(raw.vertices[i])) {
+      return std::unexpected(namer.model() + ": point " + std::to_string(i) + " is beyond " + kExtentText);
     }
   }
   auto in_range = [nv](int i) { return i >= 0 && static_cast<std::size_t>(i) < nv; };
@@ -101,6 +108,8 @@ std::expected<void, std::string> validate(const RawModel& raw, const Namer& name
       return std::unexpected(namer.circle(c) + ": is not finite");
     }
     if (!(circle.radius_m > 0)) return std::unexpected(namer.circle(c) + ": radius must be > 0");
+    if (beyond(circle.centre_obj) || circle.radius_m > kMaxModelExtentM)
+      return std::unexpected(namer.circle(c) + ": centre or radius is beyond " + kExtentText);
     if (!(circle.normal_obj.norm() > 0)) return std::unexpected(namer.circle(c) + ": normal is zero");
   }
   for (std::size_t c = 0; c < raw.cylinders.size(); ++c) {
@@ -109,6 +118,8 @@ std::expected<void, std::string> validate(const RawModel& raw, const Namer& name
       return std::unexpected(namer.cylinder(c) + ": is not finite");
     }
     if (!(cyl.radius_m > 0)) return std::unexpected(namer.cylinder(c) + ": radius must be > 0");
+    if (beyond(cyl.axis_a_obj) || beyond(cyl.axis_b_obj) || cyl.radius_m > kMaxModelExtentM)
+      return std::unexpected(namer.cylinder(c) + ": axis or radius is beyond " + kExtentText);
     if (cyl.axis_a_obj == cyl.axis_b_obj) {
       return std::unexpected(namer.cylinder(c) + ": axis end points are equal");
     }
@@ -363,14 +374,17 @@ void make_parallel_pairs(CadModel& model) {
   for (std::size_t e = 0; e < ne; ++e) {
     const Eigen::Vector3d d = model.vertices[model.edges[e].v1] - model.vertices[model.edges[e].v0];
     const double len = d.norm();
-    if (len > 0) {
+    // build_model bounds the vertices, so len is finite; an edge that is not is skipped all
+    // the same rather than cast to a grid cell as NaN.
+    if (len > 0 && std::isfinite(len)) {
       dir[e] = d / len;
-      valid[e] = 1;
+      valid[e] = dir[e].allFinite() ? 1 : 0;
     }
   }
+  // dir is a unit vector: its cells are -50..50, well inside int (clamped all the same).
   auto cell_of = [](const Eigen::Vector3d& d) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(d.x() / kCell)), static_cast<int>(std::floor(d.y() / kCell)),
-                           static_cast<int>(std::floor(d.z() / kCell)));
+    const auto cell = [](double x) { return static_cast<int>(std::clamp(std::floor(x / kCell), -100.0, 100.0)); };
+    return Eigen::Vector3i(cell(d.x()), cell(d.y()), cell(d.z()));
   };
   auto key_of = [](const Eigen::Vector3i& c) {
     return (static_cast<std::uint64_t>(c.x() + 1000) << 40) | (static_cast<std::uint64_t>(c.y() + 1000) << 20) |
@@ -395,6 +409,7 @@ void make_parallel_pairs(CadModel& model) {
               // Symmetric: the lines are parallel only up to 1 degree.
               const double distance = 0.5 * (point_line_distance(mid_b, model.vertices[a.v0], dir[other]) +
                                              point_line_distance(mid_a, model.vertices[b.v0], dir[e]));
+              if (!std::isfinite(distance)) continue;
               model.parallel_pairs.push_back({other, static_cast<int>(e), distance});
             }
           }

@@ -142,6 +142,15 @@ std::expected<Sequence, std::string> Sequence::open(const std::string& dir) {
   return seq;
 }
 
+// A calibration is for one image size: frames of another size would be tracked with the wrong
+// intrinsics, silently (most frames lost, or a wrong pose).
+std::expected<void, std::string> Sequence::check_size(const cv::Mat& image, const std::string& what) const {
+  if (image.cols == camera_.width_px() && image.rows == camera_.height_px()) return {};
+  return Error(what + ": the image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but " +
+               dir_ + "/camera.yaml is a calibration for " + std::to_string(camera_.width_px()) + "x" +
+               std::to_string(camera_.height_px()));
+}
+
 std::expected<cv::Mat, std::string> Sequence::read_frame(std::size_t index) {
   if (index >= frames_.size())
     return Error(dir_ + ": frame index " + std::to_string(index) + " out of range (" + std::to_string(frames_.size()) +
@@ -156,6 +165,7 @@ std::expected<cv::Mat, std::string> Sequence::read_frame(std::size_t index) {
       return Error(path + ": cannot decode image (" + e.err + ")");
     }
     if (image.empty()) return Error(path + ": cannot read or decode image (frame " + std::to_string(entry.frame) + ")");
+    if (auto ok = check_size(image, path); !ok) return Error(ok.error());
     return image;
   }
 
@@ -182,6 +192,7 @@ std::expected<cv::Mat, std::string> Sequence::read_frame(std::size_t index) {
       return Error(path + ": cannot decode frame " + std::to_string(index));
     }
     ++video_->next;
+    if (auto ok = check_size(image, path + " frame " + std::to_string(index)); !ok) return Error(ok.error());
     return image;
   } catch (const cv::Exception& e) {
     if (video_) video_->capture.release();

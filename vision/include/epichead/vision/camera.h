@@ -25,7 +25,8 @@ class Camera {
   Camera(int width_px, int height_px, const Intrinsics& k, const Distortion& distortion = {});
 
   // Reads image_width, image_height, camera_matrix (3x3), distortion_coefficients (1x5 or 5x1,
-  // or 1x4 / empty meaning zeros beyond). Errors name the file and the field.
+  // or 1x4 / empty meaning zeros beyond). Errors name the file and the field. Another camera
+  // model (fisheye_model, a ROS distortion_model other than plumb_bob) is an error.
   static std::expected<Camera, std::string> load(const std::string& yaml_path);
   std::expected<void, std::string> save(const std::string& yaml_path) const;
 

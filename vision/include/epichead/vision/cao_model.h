@@ -83,6 +83,10 @@ std::expected<CadModel, std::string> load_cao(const std::string& path);
 std::expected<CadModel, std::string> parse_cao(const std::string& text, const std::string& name,
                                                const std::string& base_dir = ".");
 
+// No physical model has a coordinate, radius or load() translation beyond this (1000 km):
+// larger values are an error, so that every length and distance computed from them is finite.
+inline constexpr double kMaxModelExtentM = 1e6;
+
 // Writes a model back as CAO V1 (points, lines for free edges, faces from points, cylinders, circles).
 std::string to_cao(const CadModel& model);
 

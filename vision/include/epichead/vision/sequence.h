@@ -46,7 +46,8 @@ class Sequence {
   std::size_t frame_count() const { return frames_.size(); }
 
   // Decodes frame `index` (0-based position in frames()). Sequential reads of a video are
-  // cheap; going backwards re-opens it. A corrupt or unreadable image is an error value.
+  // cheap; going backwards re-opens it. A corrupt or unreadable image, or one whose size is not
+  // the calibration's, is an error value.
   std::expected<cv::Mat, std::string> read_frame(std::size_t index);
 
   Sequence(Sequence&&) noexcept;
@@ -62,6 +63,7 @@ class Sequence {
   std::vector<StampedPose> gt_;
   std::vector<ImuRecord> imu_;
   std::vector<FrameEntry> frames_;
+  std::expected<void, std::string> check_size(const cv::Mat& image, const std::string& what) const;
   struct VideoReader;
   std::unique_ptr<VideoReader> video_;
 };
