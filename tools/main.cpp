@@ -3,6 +3,7 @@
 
 #include <iostream>
 #include <memory>
+#include <string_view>
 
 #include "command.h"
 #include "printable.h"
@@ -41,6 +42,11 @@ int usage_error(const CLI::App& app, const std::vector<std::pair<CLI::App*, Comm
     for (const auto& [sub, action] : actions) names += (names.empty() ? "" : ", ") + sub->get_name();
     std::cerr << "epichead: unknown command '" << printable(argv[1]) << "' (commands: " << names << ")\n"
               << formatter.make_usage(&app, "epichead");
+  } else if (!command && argc > 1 && std::string_view(argv[1]) != "--help" && std::string_view(argv[1]) != "-h" &&
+             std::string_view(argv[1]) != "--version") {
+    // An option before any command: CLI11 reports the missing command, the option is the mistake.
+    std::cerr << "epichead: unknown option '" << printable(argv[1]) << "'\n"
+              << formatter.make_usage(&app, "epichead") << "Run 'epichead --help' for the commands.\n";
   } else if (command) {
     std::cerr << "epichead " << command->get_name() << ": " << printable(what) << "\n"
               << formatter.make_usage(command, "epichead " + command->get_name())

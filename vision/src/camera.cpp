@@ -32,6 +32,16 @@ std::expected<int, std::string> read_size(const cv::FileStorage& fs, const std::
   return static_cast<int>(value);
 }
 
+// What an OpenCV exception says. Its YAML parser puts the reason ("(3): Invalid character", the
+// file name being empty for text in memory) where the function name goes, and the function name
+// ("parseValue") where the reason goes.
+std::string opencv_reason(const cv::Exception& e) {
+  const std::size_t at = e.func.find("): ");
+  const std::size_t open = e.func.rfind('(', at);
+  if (e.code != cv::Error::StsParseError || at == std::string::npos || open == std::string::npos) return e.err;
+  return "line " + e.func.substr(open + 1, at - open - 1) + ": " + e.func.substr(at + 3);
+}
+
 // The largest matrix side a camera YAML has a use for (distortion: 14 values at most).
 constexpr int kMaxMatrixSide = 16;
 
@@ -174,7 +184,7 @@ std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
     return load_from(fs, yaml_path);
   } catch (const cv::Exception& e) {
     // OpenCV's parser throws on text that is not YAML.
-    return Error(yaml_path + ": not OpenCV FileStorage YAML (" + e.err + hint + ")");
+    return Error(yaml_path + ": not OpenCV FileStorage YAML (" + opencv_reason(e) + hint + ")");
   } catch (const std::exception& e) {
     // OpenCV's parser also lets standard exceptions out (std::length_error, std::bad_alloc).
     return Error(yaml_path + ": not OpenCV FileStorage YAML (the parser failed: " + e.what() + hint + ")");

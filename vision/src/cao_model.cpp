@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 #include <string_view>
@@ -342,9 +343,11 @@ class Parser {
                            std::string(param.substr(0, 60)) + "'");
       }
     }
-    if (trans.cwiseAbs().maxCoeff() > kMaxModelExtentM)
-      return fail(t, "load() translation t=[" + std::to_string(trans.x()) + ";" + std::to_string(trans.y()) + ";" +
-                         std::to_string(trans.z()) + "] is beyond " + kExtentText);
+    if (trans.cwiseAbs().maxCoeff() > kMaxModelExtentM) {
+      char shown_t[96];
+      std::snprintf(shown_t, sizeof shown_t, "t=[%g;%g;%g]", trans.x(), trans.y(), trans.z());
+      return fail(t, "load() translation " + std::string(shown_t) + " is beyond " + kExtentText);
+    }
     Eigen::Isometry3d file_T_child = Eigen::Isometry3d::Identity();
     const double angle = tu.norm();
     if (angle > 0) file_T_child.linear() = Eigen::AngleAxisd(angle, tu / angle).toRotationMatrix();
