@@ -1,18 +1,6 @@
 // `epichead run --config FILE [--seconds S]`: the onboard loop on real devices: a V4L2 camera, a
-// SocketCAN bus carrying the IMU and the head, the monotonic clock. The configuration is JSON:
-//
-//   { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
-//     "init_pose": "teabox/init.csv",              // where tracking starts (cMo)
-//     "camera": { "device": "/dev/video0", "width": 640, "height": 480,
-//                 "fps": 0 },                      // 0: the driver's current frame rate
-//     "can": { "interface": "can0" },
-//     "head": { "pan_backlash_rad": 0,             // the gear's dead band per joint, as measured
-//               "tilt_backlash_rad": 0 },          // (docs/head.md); 0: no compensation
-//     "mode": "fixate",                            // fixate | stabilise | hold
-//     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
-//
-// Relative paths are taken from the configuration file's folder. Every key but the three files
-// has the default shown.
+// SocketCAN bus carrying the IMU and the head, the monotonic clock. The configuration's keys are
+// described in run_config.h.
 #include <CLI/CLI.hpp>
 
 #include <time.h>
@@ -20,13 +8,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 
-#include <nlohmann/json.hpp>
-
 #include "command.h"
+#include "run_config.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/hw/clock.h"
 #include "epichead/hw/monotonic_stamped_bus.h"
@@ -41,55 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunConfig {
-  std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
-  hw::V4l2CameraOptions camera;
-  hw::SocketCanOptions can;
-  head::JointBacklash backlash;
-};
-
-std::expected<RunConfig, std::string> read_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return std::unexpected(path + ": cannot open");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::exception& e) {
-    return std::unexpected(path + ": not valid JSON: " + e.what());
-  }
-  const fs::path base = fs::path(path).parent_path();
-  auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
-  RunConfig c;
-  try {
-    for (const char* key : {"model", "camera_calibration", "init_pose"})
-      if (!j.contains(key) || !j[key].is_string()) return std::unexpected(path + ": missing string field '" + key + "'");
-    c.model = resolve(j["model"].get<std::string>());
-    c.calibration = resolve(j["camera_calibration"].get<std::string>());
-    c.init_pose = resolve(j["init_pose"].get<std::string>());
-    c.out = resolve(j.value("out", c.out));
-    c.mode = j.value("mode", c.mode);
-    if (j.contains("camera")) {
-      const auto& cam = j["camera"];
-      c.camera.device = cam.value("device", c.camera.device);
-      c.camera.width = cam.value("width", c.camera.width);
-      c.camera.height = cam.value("height", c.camera.height);
-      c.camera.frame_rate_hz = cam.value("fps", c.camera.frame_rate_hz);
-    }
-    if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
-    if (j.contains("head")) {
-      const auto& h = j["head"];
-      c.backlash.pan_rad = h.value("pan_backlash_rad", c.backlash.pan_rad);
-      c.backlash.tilt_rad = h.value("tilt_backlash_rad", c.backlash.tilt_rad);
-    }
-  } catch (const nlohmann::json::exception& e) {
-    return std::unexpected(path + ": wrong type: " + e.what());
-  }
-  return c;
-}
-
 int run_onboard(const std::string& config_path, double seconds) {
   const char* cmd = "run";
-  auto config = read_config(config_path);
+  auto config = read_run_config(config_path);
   if (!config) return fail(cmd, config.error());
   static const std::map<std::string, head::ControlMode> modes{
       {"fixate", head::ControlMode::Fixate}, {"stabilise", head::ControlMode::Stabilise}, {"hold", head::ControlMode::Hold}};
@@ -167,7 +107,7 @@ const CommandRegistration registration{
     "run", "The onboard loop on real devices (V4L2 camera, SocketCAN IMU and head)", [](CLI::App& app) {
       auto config = std::make_shared<std::string>();
       auto seconds = std::make_shared<double>(0);
-      app.add_option("--config", *config, "JSON configuration (see the top of tools/cmd_run.cpp and the README)")->required();
+      app.add_option("--config", *config, "JSON configuration (see tools/run_config.h and the README)")->required();
       app.add_option("--seconds", *seconds, "Stop after this long (default: run until interrupted)")->check(CLI::Range(0.0, 1e9));
       return [=]() { return run_onboard(*config, *seconds); };
     }};

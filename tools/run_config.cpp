@@ -1,0 +1,86 @@
+#include "run_config.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+namespace epichead::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A number field of an object, or `fallback` when the key is absent. Checked before nlohmann
+// converts it: its get<int>() of a double out of int's range (a "width": 1e300) is undefined
+// behaviour, and it would silently truncate 640.5. The error names the field and the range.
+std::expected<double, std::string> number(const nlohmann::json& object, const char* object_name, const char* key,
+                                          double fallback, double lo, double hi, bool whole) {
+  if (!object.contains(key)) return fallback;
+  const nlohmann::json& v = object[key];
+  const std::string name = std::string(object_name) + "." + key;
+  char range[96];
+  std::snprintf(range, sizeof range, "a %s from %g to %g", whole ? "whole number" : "number", lo, hi);
+  if (!v.is_number()) return std::unexpected(name + " must be " + std::string(range));
+  const double x = v.get<double>();
+  if (!(x >= lo && x <= hi) || (whole && x != static_cast<double>(static_cast<long long>(x))))
+    return std::unexpected(name + " must be " + range + ", got " + v.dump());
+  return x;
+}
+
+}  // namespace
+
+std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::unexpected(path + ": cannot open");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    return std::unexpected(path + ": not valid JSON: " + e.what());
+  }
+  const fs::path base = fs::path(path).parent_path();
+  auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
+  RunConfig c;
+  try {
+    for (const char* key : {"model", "camera_calibration", "init_pose"})
+      if (!j.contains(key) || !j[key].is_string()) return std::unexpected(path + ": missing string field '" + key + "'");
+    c.model = resolve(j["model"].get<std::string>());
+    c.calibration = resolve(j["camera_calibration"].get<std::string>());
+    c.init_pose = resolve(j["init_pose"].get<std::string>());
+    c.out = resolve(j.value("out", c.out));
+    c.mode = j.value("mode", c.mode);
+    auto fail = [&](const std::string& what) { return std::unexpected(path + ": " + what); };
+    if (j.contains("camera")) {
+      const auto& cam = j["camera"];
+      if (!cam.is_object()) return fail("camera must be an object");
+      c.camera.device = cam.value("device", c.camera.device);
+      const auto width = number(cam, "camera", "width", c.camera.width, 1, 65535, true);
+      if (!width) return fail(width.error());
+      const auto height = number(cam, "camera", "height", c.camera.height, 1, 65535, true);
+      if (!height) return fail(height.error());
+      const auto fps = number(cam, "camera", "fps", c.camera.frame_rate_hz, 0, 1e6, false);
+      if (!fps) return fail(fps.error());
+      c.camera.width = static_cast<int>(*width);
+      c.camera.height = static_cast<int>(*height);
+      c.camera.frame_rate_hz = *fps;
+    }
+    if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
+    if (j.contains("head")) {
+      const auto& h = j["head"];
+      if (!h.is_object()) return fail("head must be an object");
+      const auto pan = number(h, "head", "pan_backlash_rad", c.backlash.pan_rad, 0, 1, false);
+      if (!pan) return fail(pan.error());
+      const auto tilt = number(h, "head", "tilt_backlash_rad", c.backlash.tilt_rad, 0, 1, false);
+      if (!tilt) return fail(tilt.error());
+      c.backlash.pan_rad = *pan;
+      c.backlash.tilt_rad = *tilt;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return std::unexpected(path + ": wrong type: " + e.what());
+  }
+  return c;
+}
+
+}  // namespace epichead::tools

@@ -1,0 +1,37 @@
+#pragma once
+// The configuration of `epichead run --config FILE`: the onboard loop on real devices. JSON:
+//
+//   { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
+//     "init_pose": "teabox/init.csv",              // where tracking starts (cMo)
+//     "camera": { "device": "/dev/video0", "width": 640, "height": 480,
+//                 "fps": 0 },                      // 0: the driver's current frame rate
+//     "can": { "interface": "can0" },
+//     "head": { "pan_backlash_rad": 0,             // the gear's dead band per joint, as measured
+//               "tilt_backlash_rad": 0 },          // (docs/head.md); 0: no compensation
+//     "mode": "fixate",                            // fixate | stabilise | hold
+//     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
+//
+// Relative paths are taken from the configuration file's folder. Every key but the three files
+// has the default shown. A library of its own (not only in cmd_run.cpp) so the fuzz target
+// tests/fuzz/fuzz_run_config.cpp links the same reader the program uses.
+#include <expected>
+#include <string>
+
+#include "epichead/head/backlash_compensation.h"
+#include "epichead/hw/socketcan_bus.h"
+#include "epichead/hw/v4l2_camera.h"
+
+namespace epichead::tools {
+
+struct RunConfig {
+  std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
+  hw::V4l2CameraOptions camera;
+  hw::SocketCanOptions can;
+  head::JointBacklash backlash;
+};
+
+// Reads the JSON file at `path`; the three file paths are resolved against its folder. Errors
+// are one line starting with the path.
+std::expected<RunConfig, std::string> read_run_config(const std::string& path);
+
+}  // namespace epichead::tools
