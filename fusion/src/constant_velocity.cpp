@@ -26,7 +26,7 @@ Eigen::Isometry3d to_cam_T_obj(const Eigen::Matrix3d& obj_R_cam, const Eigen::Ve
 
 }  // namespace
 
-void ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
+bool ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   t_s_ = t_s;
   obj_R_cam_ = cam_T_obj.linear().transpose();
   obj_p_cam_ = -(obj_R_cam_ * cam_T_obj.translation());
@@ -37,6 +37,7 @@ void ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam
   P_.topLeftCorner<6, 6>() = J * cov * J.transpose();
   P_.block<3, 3>(v, v).diagonal().setConstant(noise_.initial_speed_mps * noise_.initial_speed_mps);
   P_.block<3, 3>(w, w).diagonal().setConstant(noise_.initial_rate_radps * noise_.initial_rate_radps);
+  return true;
 }
 
 void ConstantVelocityFilter::propagate(double dt, Eigen::Matrix3d& R, Eigen::Vector3d& pos, Covariance& P) const {
@@ -65,8 +66,8 @@ void ConstantVelocityFilter::propagate(double dt, Eigen::Matrix3d& R, Eigen::Vec
   }
 }
 
-PoseUpdateResult ConstantVelocityFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                                double gate_chi2) {
+std::optional<PoseUpdateResult> ConstantVelocityFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj,
+                                                               const Matrix6d& cov, double gate_chi2) {
   Eigen::Matrix3d R = obj_R_cam_;
   Eigen::Vector3d pos = obj_p_cam_;
   Covariance P = P_;
@@ -85,7 +86,7 @@ PoseUpdateResult ConstantVelocityFilter::update(double t_s, const Eigen::Isometr
   return result;
 }
 
-PosePrediction ConstantVelocityFilter::predict(double t_s) const {
+std::optional<PosePrediction> ConstantVelocityFilter::predict(double t_s) const {
   Eigen::Matrix3d R = obj_R_cam_;
   Eigen::Vector3d pos = obj_p_cam_;
   Covariance P = P_;
