@@ -19,26 +19,19 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 
+#include "epichead/geometry/pose_covariance.h"
+#include "epichead/geometry/se3.h"
+#include "epichead/geometry/so3.h"
+
 namespace epichead::vision {
 namespace {
 
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using geometry::apply_left;
+using geometry::left_point_jacobian;
+using geometry::Matrix6d;
+using geometry::skew;
+using geometry::Vector6d;
 using RowJ = Eigen::Matrix<double, 1, 6>;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
-// d(exp(xi) X)/d(xi) at xi = 0 for xi = (translation, rotation).
-Eigen::Matrix<double, 3, 6> point_jacobian(const Eigen::Vector3d& X) {
-  Eigen::Matrix<double, 3, 6> J;
-  J.leftCols<3>().setIdentity();
-  J.rightCols<3>() = -skew(X);
-  return J;
-}
 
 // The conic of a circle's image in normalised coordinates (inside negative).
 Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::Isometry3d& cam_T_obj) {
@@ -132,28 +125,7 @@ const char* to_string(PoseStatus status) {
   return "unknown";
 }
 
-Eigen::Isometry3d apply_left(const Vector6d& xi, const Eigen::Isometry3d& pose) {
-  const Eigen::Vector3d rho = xi.head<3>(), phi = xi.tail<3>();
-  const double angle = phi.norm();
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity(), V = Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d W = skew(phi);
-  if (angle > 1e-12) {
-    const double a = std::sin(angle) / angle, b = (1 - std::cos(angle)) / (angle * angle),
-                 c = (angle - std::sin(angle)) / (angle * angle * angle);
-    R += a * W + b * W * W;
-    V += b * W + c * W * W;
-  } else {
-    R += W;
-    V += 0.5 * W;
-  }
-  Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();
-  delta.linear() = R;
-  delta.translation() = V * rho;
-  Eigen::Isometry3d out = delta * pose;
-  // Re-orthonormalise to keep round-off from accumulating over many updates.
-  out.linear() = Eigen::Quaterniond(out.linear()).normalized().toRotationMatrix();
-  return out;
-}
+Eigen::Matrix<double, 6, 6> initial_pose_covariance() { return geometry::diagonal_pose_covariance(0.01, 0.0174533); }
 
 PoseEstimator::PoseEstimator(const Camera& camera, const PoseOptions& options) : camera_(camera), options_(options) {
   residual_scratch_.reserve(4096);
@@ -244,7 +216,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       if (want_jacobian) {
         Eigen::Matrix<double, 2, 3> dn;
         dn << 1 / X.z(), 0, -X.x() / (X.z() * X.z()), 0, 1 / X.z(), -X.y() / (X.z() * X.z());
-        J2 = camera_.normalized_to_pixel_jacobian(xn) * dn * point_jacobian(X) / obs.sigma_px;
+        J2 = camera_.normalized_to_pixel_jacobian(xn) * dn * left_point_jacobian(X) / obs.sigma_px;
       }
       fn(r.x(), RowJ(J2.row(0)), slot);
       fn(r.y(), RowJ(J2.row(1)), slot);
@@ -279,7 +251,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
       const Eigen::Vector3d X = pose * obs.p_obj;
       const Eigen::Vector3d r = (X - obs.p_cam) / obs.sigma_m;
       Eigen::Matrix<double, 3, 6> J3;
-      if (want_jacobian) J3 = point_jacobian(X) / obs.sigma_m;
+      if (want_jacobian) J3 = left_point_jacobian(X) / obs.sigma_m;
       for (int i = 0; i < 3; ++i) fn(r[i], RowJ(J3.row(i)), slot);
       ++slot;
     }
