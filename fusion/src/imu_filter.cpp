@@ -4,7 +4,8 @@
 #include <cmath>
 
 #include "epichead/fusion/imu_propagation.h"
-#include "pose_covariance.h"
+#include "epichead/geometry/pose_covariance.h"
+#include "epichead/geometry/se3.h"
 
 namespace epichead::fusion {
 namespace {
@@ -102,7 +103,7 @@ bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const
   x.obj_R_grav = gravity_frame_from(-(x.obj_R_cam * options_.mount.cam_R_imu * f_mean));
 
   ErrorCovariance P = ErrorCovariance::Zero();
-  const Matrix6d J = detail::xi_to_theta_p(x.obj_R_cam);
+  const Matrix6d J = geometry::filter_pose_error_jacobian(x.obj_R_cam);
   P.topLeftCorner<6, 6>() = J * cov * J.transpose();
   const auto sq = [](double s) { return s * s; };
   P.diagonal().segment<3>(err::v).setConstant(sq(options_.initial_speed_mps));
@@ -144,7 +145,7 @@ Matrix6d ImuFilter::with_timing_uncertainty(double t_s, const StateEntry& at_t, 
   StateEntry ahead;
   double extrapolated_s = 0;
   if (!state_at(t_s + kStepS, ahead, extrapolated_s)) return cov;
-  const Vector6d rate = se3_log(ahead.x.cam_T_obj() * at_t.x.cam_T_obj().inverse()) / kStepS;
+  const Vector6d rate = geometry::se3_log(ahead.x.cam_T_obj() * at_t.x.cam_T_obj().inverse()) / kStepS;
   if (!rate.allFinite()) return cov;
   return cov + (sigma_s * sigma_s) * rate * rate.transpose();
 }

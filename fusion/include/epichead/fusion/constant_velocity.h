@@ -8,7 +8,6 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "epichead/fusion/lie.h"
 #include "epichead/fusion/pose_filter.h"
 #include "epichead/fusion/pose_prediction.h"
 #include "epichead/fusion/pose_update.h"

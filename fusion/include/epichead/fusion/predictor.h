@@ -18,7 +18,6 @@
 #include "epichead/fusion/constant_velocity.h"
 #include "epichead/fusion/imu_filter.h"
 #include "epichead/fusion/imu_sample.h"
-#include "epichead/fusion/lie.h"
 #include "epichead/fusion/nav_state.h"
 #include "epichead/fusion/pose_filter.h"
 #include "epichead/fusion/pose_prediction.h"
