@@ -7,10 +7,13 @@
 namespace epichead::geometry {
 namespace {
 
-// exp and Jl: at or below this angle the first-order forms I + W and I + W/2, whose dropped terms
-// (a^2 / 2 and a^2 / 6) are far below the rounding of 1. Above it the closed forms: the
-// cancellation in 1 - cos(a) and a - sin(a) only touches the W^2 terms, which are O(a^2) small
-// exactly when their coefficients lose digits, so the result stays within rounding of 1.
+// exp and Jl: at or below this angle the first-order forms I + W and I + W/2. Above it the closed
+// forms, as the pose solver's apply_left always had them (kept for bit-identical poses). For exp
+// that is accurate: the cancellation in 1 - cos(a) only touches the O(a^2) W^2 term. For Jl it is
+// not quite: between 1e-12 and ~1e-5 rad its W coefficient (1 - cos a) / a^2 loses digits (all of
+// them near 1e-9, where cos(a) rounds to 1), an absolute error up to a / 2 (5e-10 at 1e-9).
+// Harmless for the solver's steps, which are accepted on their cost; a series below ~1e-4 would
+// fix it and move the poses' last bits.
 constexpr double first_order_angle = 1e-12;
 // Jl^-1: below this angle the series: its closed-form coefficient divides by 1 - cos(a) and
 // loses all digits to cancellation.
