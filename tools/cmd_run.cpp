@@ -78,7 +78,7 @@ int run_onboard(const std::string& config_path, double seconds) {
   };
   head::OnboardOptions options;
   options.mode = mode->second;
-  options.controller = config->controller;  // gains and backlash from the file
+  options.controller = controller_options(*config, options.controller);  // gains and backlash from the file
   options.candump_path = (fs::path(config->out) / "bus.log").string();
   options.candump_iface = config->can.interface;
   options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();
@@ -108,7 +108,7 @@ const CommandRegistration registration{
       auto config = std::make_shared<std::string>();
       auto seconds = std::make_shared<double>(0);
       app.add_option("--config", *config, "JSON configuration (keys below)")->required();
-      app.footer(kRunConfigHelp);
+      app.footer(run_config_help(head::HeadControllerOptions{}));
       app.add_option("--seconds", *seconds, "Stop after this long (default: run until interrupted)")->check(CLI::Range(0.0, 1e9));
       return [=]() { return run_onboard(*config, *seconds); };
     }};

@@ -26,6 +26,8 @@
 #include <expected>
 #include <string>
 
+#include <optional>
+
 #include "epichead/head/head_controller.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
@@ -36,12 +38,19 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
-  // The controller: its gains and the joints' backlash from the file, the rest as the loop sets it.
-  head::HeadControllerOptions controller;
+  head::JointBacklash backlash;
+  // The controller's gains the file gives; the others keep HeadControllerOptions' defaults.
+  struct {
+    std::optional<double> stabilise_gain_per_s, fixate_gain_per_s, fixate_max_rate_radps, target_rate_filter_s,
+        target_rate_max_radps, hold_gain_per_s, hold_max_rate_radps, rate_lead_s, rate_lead_filter_s;
+  } gains;
 };
 
-// The keys, their defaults and units, as `epichead run --help` prints them.
-extern const char* const kRunConfigHelp;
+// The controller's options with the file's gains and backlash applied.
+head::HeadControllerOptions controller_options(const RunConfig& config, head::HeadControllerOptions defaults);
+
+// The keys with the defaults of `controller`, as `epichead run --help` prints them.
+std::string run_config_help(const head::HeadControllerOptions& controller);
 
 // Reads the JSON file at `path`; the three file paths are resolved against its folder. Errors
 // are one line starting with the path.

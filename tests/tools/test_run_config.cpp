@@ -24,9 +24,10 @@ TEST_CASE("run config: the controller's defaults stand when the file gives no ga
   const auto c = read_run_config(write_config(dir, ""));
   REQUIRE(c);
   const epichead::head::HeadControllerOptions defaults;
-  CHECK(c->controller.stabilise_gain_per_s == defaults.stabilise_gain_per_s);
-  CHECK(c->controller.fixate_gain_per_s == defaults.fixate_gain_per_s);
-  CHECK(c->controller.backlash.pan_rad == 0);
+  const auto o = epichead::tools::controller_options(*c, defaults);
+  CHECK(o.stabilise_gain_per_s == defaults.stabilise_gain_per_s);
+  CHECK(o.fixate_gain_per_s == defaults.fixate_gain_per_s);
+  CHECK(o.backlash.pan_rad == 0);
 }
 
 TEST_CASE("run config: gains and backlash are read into the controller's options") {
@@ -36,12 +37,13 @@ TEST_CASE("run config: gains and backlash are read into the controller's options
                                "hold_max_rate_radps": 1.25 },
              "head": { "pan_backlash_rad": 0.004 })"));
   REQUIRE(c);
-  CHECK(c->controller.stabilise_gain_per_s == 42);
-  CHECK(c->controller.fixate_gain_per_s == 2.5);
-  CHECK(c->controller.rate_lead_s == 0.006);
-  CHECK(c->controller.hold_max_rate_radps == 1.25);
-  CHECK(c->controller.backlash.pan_rad == 0.004);
-  CHECK(c->controller.target_rate_filter_s == epichead::head::HeadControllerOptions{}.target_rate_filter_s);
+  const auto o = epichead::tools::controller_options(*c, epichead::head::HeadControllerOptions{});
+  CHECK(o.stabilise_gain_per_s == 42);
+  CHECK(o.fixate_gain_per_s == 2.5);
+  CHECK(o.rate_lead_s == 0.006);
+  CHECK(o.hold_max_rate_radps == 1.25);
+  CHECK(o.backlash.pan_rad == 0.004);
+  CHECK(o.target_rate_filter_s == epichead::head::HeadControllerOptions{}.target_rate_filter_s);
 }
 
 TEST_CASE("run config: an unknown gain, a gain out of range or of the wrong type is an error naming it") {
@@ -67,4 +69,6 @@ TEST_CASE("run --help lists the configuration keys and the controller's gains") 
   for (const char* key : {"camera_calibration", "init_pose", "pan_backlash_rad", "stabilise_gain_per_s", "fixate_gain_per_s",
                           "rate_lead_s", "hold_max_rate_radps"})
     CHECK(r.out.find(key) != std::string::npos);
+  // The defaults shown are the controller's own.
+  CHECK(r.out.find("\"stabilise_gain_per_s\": 60") != std::string::npos);
 }
