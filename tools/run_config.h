@@ -30,8 +30,9 @@ struct RunConfig {
   head::JointBacklash backlash;
 };
 
-// Reads the JSON file at `path`; the three file paths are resolved against its folder. Errors
-// are one line starting with the path.
+// Reads the JSON file at `path`; the three file paths are resolved against its folder. Numbers
+// are checked: camera width and height whole numbers 1..65535, fps 0..1e6, backlashes 0..1 rad.
+// Errors are one line starting with the path.
 std::expected<RunConfig, std::string> read_run_config(const std::string& path);
 
 }  // namespace epichead::tools
