@@ -11,6 +11,7 @@
 
 #include "bench/bench.h"
 #include "command.h"
+#include "epichead/common/allocation_counter.h"
 
 namespace epichead::tools {
 namespace {
@@ -39,7 +40,7 @@ BenchResult run_one(const bench::Benchmark& b, double budget_s) {
   std::vector<double> samples_us;
   samples_us.reserve(4096);
   long long iterations = 0;
-  const unsigned long long allocs_before = bench::allocation_count();
+  const unsigned long long allocs_before = common::allocation_count();
   const auto end = Clock::now() + std::chrono::duration<double>(budget_s);
   while ((Clock::now() < end && samples_us.size() < samples_us.capacity()) || samples_us.size() < 10) {
     const auto t0 = Clock::now();
@@ -48,7 +49,7 @@ BenchResult run_one(const bench::Benchmark& b, double budget_s) {
     samples_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() / static_cast<double>(batch));
     iterations += batch;
   }
-  const unsigned long long allocs = bench::allocation_count() - allocs_before;
+  const unsigned long long allocs = common::allocation_count() - allocs_before;
   std::sort(samples_us.begin(), samples_us.end());
   auto quantile = [&](double q) {
     const std::size_t i = std::min(samples_us.size() - 1, static_cast<std::size_t>(q * static_cast<double>(samples_us.size())));

@@ -78,7 +78,7 @@ int run_onboard(const std::string& config_path, double seconds) {
   };
   head::OnboardOptions options;
   options.mode = mode->second;
-  options.controller.backlash = config->backlash;
+  options.controller = config->controller;  // gains and backlash from the file
   options.candump_path = (fs::path(config->out) / "bus.log").string();
   options.candump_iface = config->can.interface;
   options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();
@@ -107,7 +107,8 @@ const CommandRegistration registration{
     "run", "The onboard loop on real devices (V4L2 camera, SocketCAN IMU and head)", [](CLI::App& app) {
       auto config = std::make_shared<std::string>();
       auto seconds = std::make_shared<double>(0);
-      app.add_option("--config", *config, "JSON configuration (see tools/run_config.h and the README)")->required();
+      app.add_option("--config", *config, "JSON configuration (keys below)")->required();
+      app.footer(kRunConfigHelp);
       app.add_option("--seconds", *seconds, "Stop after this long (default: run until interrupted)")->check(CLI::Range(0.0, 1e9));
       return [=]() { return run_onboard(*config, *seconds); };
     }};

@@ -31,6 +31,22 @@ std::expected<double, std::string> number(const nlohmann::json& object, const ch
 
 }  // namespace
 
+const char* const kRunConfigHelp = R"(The configuration (JSON; relative paths from its folder; every key but the three files has
+the default shown):
+  { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
+    "init_pose": "teabox/init.csv",
+    "camera": { "device": "/dev/video0", "width": 640, "height": 480, "fps": 0 },
+    "can": { "interface": "can0" },
+    "head": { "pan_backlash_rad": 0, "tilt_backlash_rad": 0 },
+    "controller": { "stabilise_gain_per_s": 60, "fixate_gain_per_s": 5,
+                    "fixate_max_rate_radps": 1.5, "target_rate_filter_s": 0.15,
+                    "target_rate_max_radps": 1.0, "hold_gain_per_s": 10,
+                    "hold_max_rate_radps": 2.0, "rate_lead_s": 0, "rate_lead_filter_s": 0.004 },
+    "mode": "fixate",
+    "out": "run-out" }
+fps 0: the driver's current rate. Backlash: the gear's dead band per joint (0: none). The
+controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.)";
+
 std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
   std::ifstream in(path);
   if (!in) return std::unexpected(path + ": cannot open");
@@ -70,12 +86,41 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
     if (j.contains("head")) {
       const auto& h = j["head"];
       if (!h.is_object()) return fail("head must be an object");
-      const auto pan = number(h, "head", "pan_backlash_rad", c.backlash.pan_rad, 0, 1, false);
+      const auto pan = number(h, "head", "pan_backlash_rad", c.controller.backlash.pan_rad, 0, 1, false);
       if (!pan) return fail(pan.error());
-      const auto tilt = number(h, "head", "tilt_backlash_rad", c.backlash.tilt_rad, 0, 1, false);
+      const auto tilt = number(h, "head", "tilt_backlash_rad", c.controller.backlash.tilt_rad, 0, 1, false);
       if (!tilt) return fail(tilt.error());
-      c.backlash.pan_rad = *pan;
-      c.backlash.tilt_rad = *tilt;
+      c.controller.backlash.pan_rad = *pan;
+      c.controller.backlash.tilt_rad = *tilt;
+    }
+    if (j.contains("controller")) {
+      const auto& g = j["controller"];
+      if (!g.is_object()) return fail("controller must be an object");
+      head::HeadControllerOptions& o = c.controller;
+      // Each gain, its field and the range a sane controller stays in (rates in rad/s, times in s).
+      const struct {
+        const char* key;
+        double* field;
+        double lo, hi;
+      } gains[] = {{"stabilise_gain_per_s", &o.stabilise_gain_per_s, 0, 1000},
+                   {"fixate_gain_per_s", &o.fixate_gain_per_s, 0, 1000},
+                   {"fixate_max_rate_radps", &o.fixate_max_rate_radps, 0, 50},
+                   {"target_rate_filter_s", &o.target_rate_filter_s, 0, 10},
+                   {"target_rate_max_radps", &o.target_rate_max_radps, 0, 50},
+                   {"hold_gain_per_s", &o.hold_gain_per_s, 0, 1000},
+                   {"hold_max_rate_radps", &o.hold_max_rate_radps, 0, 50},
+                   {"rate_lead_s", &o.rate_lead_s, 0, 1},
+                   {"rate_lead_filter_s", &o.rate_lead_filter_s, 0, 1}};
+      for (const auto& gain : gains) {
+        const auto v = number(g, "controller", gain.key, *gain.field, gain.lo, gain.hi, false);
+        if (!v) return fail(v.error());
+        *gain.field = *v;
+      }
+      for (const auto& [key, value] : g.items()) {
+        bool known = false;
+        for (const auto& gain : gains) known = known || key == gain.key;
+        if (!known) return fail("controller." + key + " is not a controller gain (docs: epichead run --help)");
+      }
     }
   } catch (const nlohmann::json::exception& e) {
     return std::unexpected(path + ": wrong type: " + e.what());

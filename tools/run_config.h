@@ -8,6 +8,15 @@
 //     "can": { "interface": "can0" },
 //     "head": { "pan_backlash_rad": 0,             // the gear's dead band per joint, as measured
 //               "tilt_backlash_rad": 0 },          // (docs/head.md); 0: no compensation
+//     "controller": { "stabilise_gain_per_s": 60,   // optical-axis angle error -> camera rate
+//                     "fixate_gain_per_s": 5,       // target angle error -> camera rate
+//                     "fixate_max_rate_radps": 1.5, // how fast fixation itself may turn the camera
+//                     "target_rate_filter_s": 0.15, // low-pass of the target direction's rate
+//                     "target_rate_max_radps": 1.0, // bound on that rate's feed-forward
+//                     "hold_gain_per_s": 10,        // joint angle error -> joint rate (hold, park)
+//                     "hold_max_rate_radps": 2.0,
+//                     "rate_lead_s": 0,             // body-rate prediction; 0: off (docs/head.md)
+//                     "rate_lead_filter_s": 0.004 },
 //     "mode": "fixate",                            // fixate | stabilise | hold
 //     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
 //
@@ -17,7 +26,7 @@
 #include <expected>
 #include <string>
 
-#include "epichead/head/backlash_compensation.h"
+#include "epichead/head/head_controller.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
 
@@ -27,12 +36,16 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
-  head::JointBacklash backlash;
+  // The controller: its gains and the joints' backlash from the file, the rest as the loop sets it.
+  head::HeadControllerOptions controller;
 };
 
+// The keys, their defaults and units, as `epichead run --help` prints them.
+extern const char* const kRunConfigHelp;
+
 // Reads the JSON file at `path`; the three file paths are resolved against its folder. Numbers
-// are checked: camera width and height whole numbers 1..65535, fps 0..1e6, backlashes 0..1 rad.
-// Errors are one line starting with the path.
+// are checked: camera width and height whole numbers 1..65535, fps 0..1e6, backlashes 0..1 rad,
+// the controller's gains within their ranges. Errors are one line starting with the path.
 std::expected<RunConfig, std::string> read_run_config(const std::string& path);
 
 }  // namespace epichead::tools

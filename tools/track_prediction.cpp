@@ -6,7 +6,7 @@
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
-#include "epichead/vision/pose_covariance.h"
+#include "epichead/vision/pose_estimator.h"
 
 namespace epichead::tools {
 namespace {

@@ -2,8 +2,10 @@
 
 #include <cmath>
 
+#include "epichead/geometry/pose_covariance.h"
+#include "epichead/geometry/se3.h"
+#include "epichead/geometry/so3.h"
 #include "kalman_update.h"
-#include "pose_covariance.h"
 
 namespace epichead::fusion {
 namespace {
@@ -26,21 +28,22 @@ Eigen::Isometry3d to_cam_T_obj(const Eigen::Matrix3d& obj_R_cam, const Eigen::Ve
 
 }  // namespace
 
-void ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
+bool ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   t_s_ = t_s;
   obj_R_cam_ = cam_T_obj.linear().transpose();
   obj_p_cam_ = -(obj_R_cam_ * cam_T_obj.translation());
   obj_v_cam_.setZero();
   omega_cam_radps_.setZero();
   P_.setZero();
-  const Matrix6d J = detail::xi_to_theta_p(obj_R_cam_);
+  const Matrix6d J = geometry::filter_pose_error_jacobian(obj_R_cam_);
   P_.topLeftCorner<6, 6>() = J * cov * J.transpose();
   P_.block<3, 3>(v, v).diagonal().setConstant(noise_.initial_speed_mps * noise_.initial_speed_mps);
   P_.block<3, 3>(w, w).diagonal().setConstant(noise_.initial_rate_radps * noise_.initial_rate_radps);
+  return true;
 }
 
 void ConstantVelocityFilter::propagate(double dt, Eigen::Matrix3d& R, Eigen::Vector3d& pos, Covariance& P) const {
-  const Eigen::Matrix3d dR = so3_exp(omega_cam_radps_ * dt);
+  const Eigen::Matrix3d dR = geometry::so3_exp(omega_cam_radps_ * dt);
   R = R * dR;
   pos += obj_v_cam_ * dt;
   Covariance F = Covariance::Identity();
@@ -65,19 +68,19 @@ void ConstantVelocityFilter::propagate(double dt, Eigen::Matrix3d& R, Eigen::Vec
   }
 }
 
-PoseUpdateResult ConstantVelocityFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                                double gate_chi2) {
+std::optional<PoseUpdateResult> ConstantVelocityFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj,
+                                                               const Matrix6d& cov, double gate_chi2) {
   Eigen::Matrix3d R = obj_R_cam_;
   Eigen::Vector3d pos = obj_p_cam_;
   Covariance P = P_;
   propagate(t_s - t_s_, R, pos, P);
-  const Vector6d r = se3_log(cam_T_obj * to_cam_T_obj(R, pos).inverse());
+  const Vector6d r = geometry::se3_log(cam_T_obj * to_cam_T_obj(R, pos).inverse());
   Eigen::Matrix<double, dim, 1> dx;
   PoseUpdateResult result;
   result.mahalanobis2 = detail::kalman_update<dim>(P, cv_pose_jacobian(R), r, cov, gate_chi2, dx, result.applied);
   if (!result.applied) return result;  // a gated pose leaves the filter where it was
   t_s_ = t_s;
-  obj_R_cam_ = Eigen::Quaterniond(R * so3_exp(dx.segment<3>(th))).normalized().toRotationMatrix();
+  obj_R_cam_ = Eigen::Quaterniond(R * geometry::so3_exp(dx.segment<3>(th))).normalized().toRotationMatrix();
   obj_p_cam_ = pos + dx.segment<3>(p);
   obj_v_cam_ += dx.segment<3>(v);
   omega_cam_radps_ += dx.segment<3>(w);
@@ -85,7 +88,7 @@ PoseUpdateResult ConstantVelocityFilter::update(double t_s, const Eigen::Isometr
   return result;
 }
 
-PosePrediction ConstantVelocityFilter::predict(double t_s) const {
+std::optional<PosePrediction> ConstantVelocityFilter::predict(double t_s) const {
   Eigen::Matrix3d R = obj_R_cam_;
   Eigen::Vector3d pos = obj_p_cam_;
   Covariance P = P_;

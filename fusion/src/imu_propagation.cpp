@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "epichead/geometry/so3.h"
+
 namespace epichead::fusion {
 
 void propagate(NavState& x, ErrorCovariance& P, const ImuSample& s0, const ImuSample& s1, const ImuMount& mount,
@@ -17,7 +19,7 @@ void propagate(NavState& x, ErrorCovariance& P, const ImuSample& s0, const ImuSa
   const Eigen::Vector3d f0 = C * (s0.accel_mps2 - x.accel_bias_mps2);
   const Eigen::Vector3d f1 = C * (s1.accel_mps2 - x.accel_bias_mps2);
   const Eigen::Matrix3d R0 = x.obj_R_cam;
-  const Eigen::Matrix3d dR = so3_exp(omega * dt);
+  const Eigen::Matrix3d dR = geometry::so3_exp(omega * dt);
   const Eigen::Vector3d g = x.gravity_obj_mps2();
   const Eigen::Vector3d a0 = R0 * f0 + g;
   x.obj_R_cam = R0 * dR;
@@ -32,7 +34,7 @@ void propagate(NavState& x, ErrorCovariance& P, const ImuSample& s0, const ImuSa
   const Eigen::Vector3d f_mid = 0.5 * (f0 + f1);
   const Eigen::Matrix3d F_tt = dR.transpose();                   // d theta' / d theta
   const Eigen::Matrix3d F_tbg = -C * dt;                         // d theta' / d bg
-  const Eigen::Matrix3d F_vt = -R0 * skew(f_mid) * dt;           // d v' / d theta
+  const Eigen::Matrix3d F_vt = -R0 * geometry::skew(f_mid) * dt; // d v' / d theta
   const Eigen::Matrix3d F_vba = -R0 * C * dt;                    // d v' / d ba
   const Eigen::Matrix<double, 3, 2> F_vg = gravity_jacobian(x) * dt;  // d v' / d gravity
   using namespace err;

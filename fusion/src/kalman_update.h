@@ -5,9 +5,12 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "epichead/fusion/lie.h"
+#include "epichead/geometry/se3.h"
 
 namespace epichead::fusion::detail {
+
+using geometry::Matrix6d;
+using geometry::Vector6d;
 
 // Computes the correction dx for innovation r with measurement covariance Rm; updates P (Joseph
 // form, symmetrised). Returns r' S^-1 r; when it exceeds gate_chi2, P and dx are left untouched

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "epichead/geometry/so3.h"
+
 namespace epichead::fusion {
 namespace {
 
@@ -38,12 +40,12 @@ Eigen::Matrix3d gravity_frame_from(const Eigen::Vector3d& gravity_obj) {
 }
 
 void inject(NavState& x, const ErrorVector& dx) {
-  x.obj_R_cam = x.obj_R_cam * so3_exp(dx.segment<3>(err::theta));
+  x.obj_R_cam = x.obj_R_cam * geometry::so3_exp(dx.segment<3>(err::theta));
   x.obj_p_cam += dx.segment<3>(err::p);
   x.obj_v_cam += dx.segment<3>(err::v);
   x.gyro_bias_radps += dx.segment<3>(err::bg);
   x.accel_bias_mps2 += dx.segment<3>(err::ba);
-  x.obj_R_grav = x.obj_R_grav * so3_exp(Eigen::Vector3d(dx[err::grav], dx[err::grav + 1], 0));
+  x.obj_R_grav = x.obj_R_grav * geometry::so3_exp(Eigen::Vector3d(dx[err::grav], dx[err::grav + 1], 0));
   // Re-orthonormalise so that round-off does not accumulate over thousands of updates.
   x.obj_R_cam = Eigen::Quaterniond(x.obj_R_cam).normalized().toRotationMatrix();
   x.obj_R_grav = Eigen::Quaterniond(x.obj_R_grav).normalized().toRotationMatrix();
@@ -51,7 +53,7 @@ void inject(NavState& x, const ErrorVector& dx) {
 
 ErrorVector error_between(const NavState& truth, const NavState& estimate) {
   ErrorVector dx;
-  dx.segment<3>(err::theta) = so3_log(estimate.obj_R_cam.transpose() * truth.obj_R_cam);
+  dx.segment<3>(err::theta) = geometry::so3_log(estimate.obj_R_cam.transpose() * truth.obj_R_cam);
   dx.segment<3>(err::p) = truth.obj_p_cam - estimate.obj_p_cam;
   dx.segment<3>(err::v) = truth.obj_v_cam - estimate.obj_v_cam;
   dx.segment<3>(err::bg) = truth.gyro_bias_radps - estimate.gyro_bias_radps;
@@ -78,7 +80,7 @@ PoseJacobian pose_jacobian(const NavState& x) {
 
 Eigen::Matrix<double, 3, 2> gravity_jacobian(const NavState& x) {
   // g(dg) = R_grav exp([dg, 0]) g0  =>  dg/d(dg) = -R_grav [g0]x E.
-  return -x.obj_R_grav * skew(gravity_in_grav_frame) * tangent_basis();
+  return -x.obj_R_grav * geometry::skew(gravity_in_grav_frame) * tangent_basis();
 }
 
 }  // namespace epichead::fusion

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "epichead/fusion/lie.h"
+#include "epichead/geometry/so3.h"
 
 namespace epichead::fusion {
 
@@ -61,7 +61,7 @@ void TimeOffsetEstimator::add_pose(double t_cam_s, const Eigen::Isometry3d& cam_
   const Eigen::Matrix3d R = cam_T_obj.linear();
   if (have_pose_ && t_cam_s - last_pose_t_s_ <= options_.max_pair_gap_s) {
     // cam_a_R_cam_b = R_a R_b^T = exp(w dt), w in camera axes.
-    const Eigen::Vector3d w = so3_log(last_R_ * R.transpose()) / (t_cam_s - last_pose_t_s_);
+    const Eigen::Vector3d w = geometry::so3_log(last_R_ * R.transpose()) / (t_cam_s - last_pose_t_s_);
     if (pairs_.size() == pairs_.capacity()) drop_front(pairs_, pairs_.size() / 2);
     pairs_.push_back({last_pose_t_s_, t_cam_s, w});
   }

@@ -9,8 +9,8 @@ void JointRateEstimate::sent(double t_s, const Eigen::Vector2d& rates_radps, con
   const double act_t_s = t_s + options_.command_delay_s;
   // Where the modelled joint rates stand when this command starts to act.
   Eigen::Vector2d model = rates_radps, output_model = output_rates_radps;
-  if (count_ > 0) {
-    const Sent& prev = sent_[newest_];
+  if (!sent_.empty()) {
+    const Sent& prev = sent_.newest();
     if (act_t_s < prev.t_s) return;
     if (options_.motor_lag_s > 0) {
       model = model_at(prev, act_t_s);
@@ -19,14 +19,12 @@ void JointRateEstimate::sent(double t_s, const Eigen::Vector2d& rates_radps, con
   } else if (options_.motor_lag_s > 0) {
     model = output_model = measured_;  // the first command starts from the joints' measured motion
   }
-  newest_ = count_ == 0 ? 0 : (newest_ + 1) % kCapacity;
-  sent_[newest_] = {act_t_s, rates_radps, model, output_rates_radps, output_model};
-  count_ = std::min(count_ + 1, kCapacity);
+  sent_.push_overwrite({act_t_s, rates_radps, model, output_rates_radps, output_model});
 }
 
 const JointRateEstimate::Sent* JointRateEstimate::in_force(double t_s) const {
-  for (std::size_t i = 0; i < count_; ++i) {
-    const Sent& s = sent_[(newest_ + kCapacity - i) % kCapacity];
+  for (std::size_t i = sent_.size(); i-- > 0;) {  // newest first
+    const Sent& s = sent_[i];
     if (s.t_s <= t_s) return t_s - s.t_s <= options_.max_command_age_s ? &s : nullptr;
   }
   return nullptr;
@@ -58,8 +56,7 @@ Eigen::Vector2d JointRateEstimate::at(double t_s) const {
 }
 
 void JointRateEstimate::reset() {
-  count_ = 0;
-  newest_ = 0;
+  sent_.clear();
   correction_.setZero();
 }
 

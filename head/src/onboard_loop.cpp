@@ -12,8 +12,8 @@
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
+#include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/window_image.h"
-#include "epichead/vision/pose_covariance.h"
 #include "recent_samples.h"
 
 namespace epichead::head {

@@ -34,7 +34,7 @@ GpioWait GpioEventFdReader::wait(GpioEdge& out, double timeout_s) {
       if (errno == EINTR || errno == EAGAIN) continue;
       return fail("cannot read an edge event", errno);
     }
-    out.timestamp_ns = static_cast<std::int64_t>(event.ts.tv_sec) * 1'000'000'000 + event.ts.tv_nsec;
+    out.t_s = static_cast<double>(event.ts.tv_sec) + static_cast<double>(event.ts.tv_nsec) * 1e-9;  // as clock.cpp
     out.kind = event.event_type == GPIOD_LINE_EVENT_FALLING_EDGE ? GpioEdgeKind::Falling : GpioEdgeKind::Rising;
     ++edges_;
     return GpioWait::Edge;

@@ -3,24 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "saturate.h"
 #include "simulate_random.h"
 
 namespace epichead::sim {
 namespace {
 
 Eigen::Vector3d normal3(Random& rng) { return {rng.normal(), rng.normal(), rng.normal()}; }
-
-// Clips each axis to +-range; true when any axis was clipped.
-bool saturate(Eigen::Vector3d& v, double range) {
-  bool clipped = false;
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs(v[i]) > range) {
-      v[i] = std::copysign(range, v[i]);
-      clipped = true;
-    }
-  }
-  return clipped;
-}
 
 }  // namespace
 

@@ -11,11 +11,8 @@
 #include <set>
 #include <sstream>
 
+#include "epichead/sim/builtin_asset.h"
 #include "epichead/sim/scene_library.h"
-
-#ifndef EPICHEAD_SCENARIO_DIR
-#define EPICHEAD_SCENARIO_DIR "sim/scenarios"
-#endif
 
 namespace epichead::sim {
 namespace {
@@ -452,11 +449,14 @@ const std::vector<std::string>& builtin_scenario_names() {
   return names;
 }
 
-std::string scenarios_dir() { return EPICHEAD_SCENARIO_DIR; }
-
 std::expected<Scenario, std::string> find_scenario(const std::string& name_or_path) {
   for (const auto& n : builtin_scenario_names()) {
-    if (n == name_or_path) return load_scenario(scenarios_dir() + "/" + n + ".scn");
+    if (n != name_or_path) continue;
+    // Built into the program (builtin_asset.h): no file to find, wherever the binary runs.
+    const std::string file = n + ".scn";
+    const auto text = builtin_asset_text("scenarios/" + file);
+    if (!text) return std::unexpected(file + ":0: the built-in scenario is missing from the program");
+    return parse_scenario(std::string(*text), file);
   }
   if (!std::filesystem::exists(name_or_path)) {
     std::string known;

@@ -5,9 +5,10 @@
 #include <cmath>
 #include <numbers>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "epichead/sim/builtin_asset.h"
+#include "scene_photo.h"
 #include "texture.h"
 
 namespace epichead::sim {
@@ -246,13 +247,6 @@ void add_walls(Scene& s, double cx, double cy, double half_x, double half_y, dou
   s.background.planes.push_back(wall({cx, cy - half_y, zc}, Vector3d::UnitY(), 2 * half_x, height, textures[3]));
 }
 
-std::expected<cv::Mat, std::string> photo(const std::string& file) {
-  const std::string path = scenes_dir() + "/" + file;
-  cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-  if (img.empty()) return std::unexpected(path + ": cannot read the image");
-  return img;
-}
-
 void set_view(Scene& s, const Vector3d& camera, const Vector3d& target, double min_m, double max_m) {
   s.view.camera_world = camera;
   s.view.target_world = target;
@@ -359,9 +353,9 @@ std::expected<void, std::string> build_lampshade(Scene& s, std::uint64_t print_s
   path.period_s = 6.0;
   s.occluder_paths.push_back(path);
 
-  auto street = photo("building.jpg");
+  auto street = scene_photo("building.jpg");
   if (!street) return std::unexpected(street.error());
-  auto board = photo("board.jpg");
+  auto board = scene_photo("board.jpg");
   if (!board) return std::unexpected(board.error());
   const int t_street = add_texture(s, *street), t_board = add_texture(s, *board);
   const int t_clutter = add_texture(s, texture::clutter({1024, 600}, 31));
@@ -390,11 +384,11 @@ std::expected<void, std::string> build_box_clutter(Scene& s, std::uint64_t print
   }
   s.object_mesh = mesh_from_model(s.model, face_material);
 
-  auto board = photo("board.jpg");
+  auto board = scene_photo("board.jpg");
   if (!board) return std::unexpected(board.error());
-  auto street = photo("building.jpg");
+  auto street = scene_photo("building.jpg");
   if (!street) return std::unexpected(street.error());
-  auto desk = photo("stuff.jpg");
+  auto desk = scene_photo("stuff.jpg");
   if (!desk) return std::unexpected(desk.error());
   const int t_board = add_texture(s, *board), t_street = add_texture(s, *street), t_desk = add_texture(s, *desk);
   const int t_clutter = add_texture(s, texture::clutter({1024, 640}, 41));
@@ -450,7 +444,7 @@ std::expected<void, std::string> build_office_pan(Scene& s, std::uint64_t print_
   add_quad(scenery, {2.20, -0.004, 0.0}, {3.10, -0.004, 0.0}, {3.10, -0.004, 2.05}, {2.20, -0.004, 2.05}, door);
   const int brass = add_material(s, plain(0.2f, 0.55f, 0.7f));
   add_box(scenery, Eigen::Isometry3d(Eigen::Translation3d(2.98, -0.03, 1.0)), {0.12, 0.02, 0.025}, brass);
-  auto graffiti = photo("graf1.jpg");
+  auto graffiti = scene_photo("graf1.jpg");
   if (!graffiti) return std::unexpected(graffiti.error());
   Material poster = plain(1.f, 1.f, 1.f);
   poster.texture = add_texture(s, *graffiti);
@@ -492,11 +486,11 @@ std::expected<void, std::string> build_office_pan(Scene& s, std::uint64_t print_
 // A table top with clutter around it: a wooden floor plane at z = 0 and four walls of photos
 // and clutter (can, bowl).
 std::expected<void, std::string> add_table_surroundings(Scene& s, std::uint64_t clutter_seed, std::uint64_t wood_seed) {
-  auto desk = photo("stuff.jpg");
+  auto desk = scene_photo("stuff.jpg");
   if (!desk) return std::unexpected(desk.error());
-  auto street = photo("building.jpg");
+  auto street = scene_photo("building.jpg");
   if (!street) return std::unexpected(street.error());
-  auto graffiti = photo("graf1.jpg");
+  auto graffiti = scene_photo("graf1.jpg");
   if (!graffiti) return std::unexpected(graffiti.error());
   const int t_desk = add_texture(s, *desk), t_street = add_texture(s, *street), t_graf = add_texture(s, *graffiti);
   const int t_clutter = add_texture(s, texture::clutter({1024, 640}, clutter_seed));
@@ -574,15 +568,9 @@ const std::vector<std::string>& scene_names() {
   return names;
 }
 
-std::string scenes_dir() {
-#ifdef EPICHEAD_SCENES_DIR
-  return EPICHEAD_SCENES_DIR;
-#else
-  return "sim/scenes";
-#endif
+std::optional<std::string_view> scene_model_cao(std::string_view name) {
+  return builtin_asset_text("scenes/" + std::string(name) + ".cao");
 }
-
-std::string scene_model_path(std::string_view name) { return scenes_dir() + "/" + std::string(name) + ".cao"; }
 
 std::expected<vision::CadModel, std::string> make_scene_model(std::string_view name) { return model_of(name); }
 

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <numbers>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "epichead/sim/rig.h"
 #include "epichead/sim/scene_library.h"
+#include "scene_photo.h"
 #include "simulate_random.h"
 #include "texture.h"
 
@@ -246,15 +246,15 @@ const std::array<const char*, 9> kWallTextures = {"board.jpg", "building.jpg", "
                                                   "wood",      "concrete",     "plaster",   "parquet"};
 const std::array<const char*, 5> kFloorTextures = {"wood", "concrete", "parquet", "stuff.jpg", "board.jpg"};
 
-// Makes the named texture (photos from scenes_dir()); sets how densely it is drawn on the plane.
+// Makes the named texture (a built-in photo or a procedural one); sets how densely it is drawn
+// on the plane.
 std::expected<cv::Mat, std::string> background_texture(const std::string& name, bool floor, std::uint64_t seed,
                                                        const std::array<double, 3>& colour, double& px_per_m) {
   if (name.ends_with(".jpg")) {
-    const std::string path = scenes_dir() + "/" + name;
-    cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-    if (img.empty()) return std::unexpected(path + ": cannot read the image");
-    px_per_m = floor ? img.cols / 0.6 : 0;  // a floor: 0.6 m tiles; a wall: stretched over it
-    return img;
+    auto img = scene_photo(name);
+    if (!img) return std::unexpected(img.error());
+    px_per_m = floor ? img->cols / 0.6 : 0;  // a floor: 0.6 m tiles; a wall: stretched over it
+    return *img;
   }
   if (name == "clutter") { px_per_m = floor ? 600 : 0; return texture::clutter({1024, 640}, seed); }
   if (name == "wood") { px_per_m = floor ? 800 : 500; return texture::wood({512, 512}, seed); }

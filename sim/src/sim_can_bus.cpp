@@ -46,7 +46,7 @@ std::expected<void, std::string> SimCanBus::send(const CanFrame& frame) {
     std::snprintf(buf, sizeof buf, "sim CAN: send refused for id 0x%X: %s", frame.id, why);
     return std::unexpected(std::string(buf));
   }
-  if (!to_nodes_.push({t + timing_.command_latency_us * 1e-6, frame})) {
+  if (!to_nodes_.try_push({t + timing_.command_latency_us * 1e-6, frame})) {
     ++stats_.tx_failed;
     return std::unexpected("sim CAN: send refused: transmit queue full");
   }
@@ -67,10 +67,10 @@ hw::CanReceive SimCanBus::receive(StampedCanFrame& out, double timeout_s) {
       last_error_ = buf;
       return hw::CanReceive::Error;
     }
-    if (!to_host_.empty() && to_host_.front().t_s <= t) {
-      out.stamp_us = to_us(to_host_.front().t_s);
-      out.frame = to_host_.front().frame;
-      to_host_.pop();
+    if (!to_host_.empty() && to_host_.oldest().t_s <= t) {
+      out.stamp_us = to_us(to_host_.oldest().t_s);
+      out.frame = to_host_.oldest().frame;
+      to_host_.pop_front();
       ++stats_.rx_frames;
       return hw::CanReceive::Frame;
     }
@@ -106,7 +106,7 @@ void SimCanBus::node_send(const CanFrame& frame, double t_s) {
     return;
   }
   const double arrival = std::max(t_s + (timing_.latency_us + jitter_us) * 1e-6, last_arrival_s_);
-  if (!to_host_.push({arrival, frame})) {
+  if (!to_host_.try_push({arrival, frame})) {
     ++counters_.rx_queue_overflow;
     ++stats_.rx_dropped;
     return;
@@ -117,18 +117,18 @@ void SimCanBus::node_send(const CanFrame& frame, double t_s) {
 
 std::optional<double> SimCanBus::next_delivery_s() const {
   if (to_nodes_.empty()) return std::nullopt;
-  return to_nodes_.front().t_s;
+  return to_nodes_.oldest().t_s;
 }
 
 firmware_iface::CanFrame SimCanBus::pop_delivery() {
-  const CanFrame f = to_nodes_.front().frame;
-  to_nodes_.pop();
+  const CanFrame f = to_nodes_.oldest().frame;
+  to_nodes_.pop_front();
   return f;
 }
 
 std::optional<double> SimCanBus::next_arrival_s() const {
   if (to_host_.empty()) return std::nullopt;
-  return to_host_.front().t_s;
+  return to_host_.oldest().t_s;
 }
 
 }  // namespace epichead::sim

@@ -7,22 +7,12 @@
 #include "epichead/firmware_iface/heartbeat.h"
 #include "epichead/firmware_iface/imu_frames.h"
 #include "epichead/firmware_iface/version.h"
+#include "saturate.h"
 
 namespace epichead::sim {
 namespace {
 
 namespace fw = firmware_iface;
-
-bool saturate(Eigen::Vector3d& v, double range) {
-  bool clipped = false;
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs(v[i]) > range) {
-      v[i] = std::copysign(range, v[i]);
-      clipped = true;
-    }
-  }
-  return clipped;
-}
 
 // The still-mount run that supplies the errors: no saturation (applied to the real values later).
 ImuRun draw_errors(ImuParams p, std::uint64_t seed, double t0_s, double t1_s) {

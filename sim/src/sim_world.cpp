@@ -119,7 +119,7 @@ std::expected<std::unique_ptr<SimWorld>, std::string> SimWorld::create(const Sce
   w->camera_ = std::make_unique<SimCamera>(*w, std::move(renderer), w->camera_model_.width_px(),
                                            w->camera_model_.height_px(), exposure_s, subframes);
   w->camera_->set_advance(advance);
-  w->history_ = RingQueue<HeadTick>(static_cast<std::size_t>(std::ceil(options.history_s * s.head_dynamics.servo_rate_hz)) + 2);
+  w->history_ = common::RingBuffer<HeadTick>(static_cast<std::size_t>(std::ceil(options.history_s * s.head_dynamics.servo_rate_hz)) + 2);
   w->run_until(0.0);
   return w;
 }
@@ -167,8 +167,7 @@ void SimWorld::run_until(double t_end_s) {
     switch (source) {
       case Tick:
         head_->tick(t, faults_.joint_stuck(Joint::pan, t), faults_.joint_stuck(Joint::tilt, t));
-        if (history_.full()) history_.pop();
-        history_.push(head_->current());
+        history_.push_overwrite(head_->current());
         ++tick_index_;
         break;
       case Delivery:
@@ -228,19 +227,19 @@ void SimWorld::deliver_to_nodes(const fw::CanFrame& frame, double t_s) {
 }
 
 std::expected<SimTruth, std::string> SimWorld::truth_at(double t_s) const {
-  const double oldest = history_.empty() ? now_s_ : std::max(history_.front().t_s, now_s_ - options_.history_s);
+  const double oldest = history_.empty() ? now_s_ : std::max(history_.oldest().t_s, now_s_ - options_.history_s);
   if (!(t_s >= oldest && t_s <= now_s_) || history_.empty())
     return std::unexpected(fmt("sim world: truth is kept from %.6f s to now, %.6f s", oldest, now_s_) + " (asked " +
                            std::to_string(t_s) + " s)");
   // Ticks are evenly spaced: the one that contains t_s, from the front's time.
   const double tick_s = 1.0 / scenario_.head_dynamics.servo_rate_hz;
-  auto i = static_cast<std::size_t>(std::max(0.0, std::floor((t_s - history_.front().t_s) / tick_s)));
+  auto i = static_cast<std::size_t>(std::max(0.0, std::floor((t_s - history_.oldest().t_s) / tick_s)));
   i = std::min(i, history_.size() - 1);
   // The last tick that started at or before t_s, exactly as the run saw it (an IMU sample an ulp
   // before a tick used the previous one).
-  while (i > 0 && history_.at(i).t_s > t_s) --i;
-  while (i + 1 < history_.size() && history_.at(i + 1).t_s <= t_s) ++i;
-  const HeadTick& tick = history_.at(i);
+  while (i > 0 && history_[i].t_s > t_s) --i;
+  while (i + 1 < history_.size() && history_[i + 1].t_s <= t_s) ++i;
+  const HeadTick& tick = history_[i];
   SimTruth truth;
   truth.t_s = t_s;
   truth.joints = output_angles_at(tick, t_s);

@@ -76,14 +76,10 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, 
   const double t_last = s.frame_time_s(s.frames - 1);
 
   if (auto ok = camera->save((dir / "camera.yaml").string()); !ok) return std::unexpected(ok.error());
-  std::error_code ec;
-  const std::string model_src = scene_model_path(s.scene);
-  if (fs::exists(model_src)) {
-    fs::copy_file(model_src, dir / "model.cao", fs::copy_options::overwrite_existing, ec);
-    if (ec) return std::unexpected("cannot copy " + model_src + ": " + ec.message());
-  } else if (auto ok = write_text(dir / "model.cao", vision::to_cao(scene->model)); !ok) {
+  // The scene's CAO file as built into the program (byte for byte sim/scenes/<scene>.cao).
+  const auto model_cao = scene_model_cao(s.scene);
+  if (auto ok = write_text(dir / "model.cao", model_cao ? std::string(*model_cao) : vision::to_cao(scene->model)); !ok)
     return std::unexpected(ok.error());
-  }
 
   // Ground truth at each frame's mid-exposure (= the frame time), and the perturbed start.
   std::vector<vision::StampedPose> gt;

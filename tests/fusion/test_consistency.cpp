@@ -5,9 +5,11 @@
 #include <vector>
 
 #include "epichead/fusion/predictor.h"
+#include "epichead/geometry/se3.h"
 #include "truth_helpers.h"
 
 using namespace epichead::fusion;
+namespace geometry = epichead::geometry;
 using namespace epichead::fusion::testing;
 
 namespace {
@@ -69,7 +71,7 @@ TEST_CASE("NEES averaged over 20 runs stays within its 99% chi-square bounds (la
                    // Pose NEES in the vision convention (left perturbation of cam_T_obj).
                    const auto pred = predictor->predict(t_cam);
                    REQUIRE(pred);
-                   const Vector6d xi = se3_log(traj.at(t_cam).x.cam_T_obj() * pred->cam_T_obj.inverse());
+                   const Vector6d xi = geometry::se3_log(traj.at(t_cam).x.cam_T_obj() * pred->cam_T_obj.inverse());
                    nees_pose[next] += xi.dot(pred->covariance.ldlt().solve(xi));
                    ++next;
                  });

@@ -7,9 +7,11 @@
 #include <string>
 
 #include "epichead/fusion/predictor.h"
+#include "epichead/geometry/se3.h"
 #include "truth_helpers.h"
 
 using namespace epichead::fusion;
+namespace geometry = epichead::geometry;
 using namespace epichead::fusion::testing;
 
 namespace {
@@ -120,7 +122,7 @@ TEST_CASE("a gross vision outlier is gated by its Mahalanobis distance and leave
   Predictor& p = r.predictor;
   const double t = 0.49;
   const NavState before = *p.state();
-  const Eigen::Isometry3d outlier = se3_exp((Vector6d() << 0.3, 0, 0, 0, 0.2, 0).finished()) * r.traj.at(t).x.cam_T_obj();
+  const Eigen::Isometry3d outlier = geometry::se3_exp((Vector6d() << 0.3, 0, 0, 0, 0.2, 0).finished()) * r.traj.at(t).x.cam_T_obj();
   const VisionResult gated = p.add_vision(t, outlier, pose_cov(0.003, 0.004));
   CHECK(gated.verdict == VisionVerdict::Gated);
   CHECK(gated.mahalanobis2 > p.options().gate_chi2);
@@ -141,7 +143,7 @@ TEST_CASE("after reinit_after_gated gated poses in a row the next pose re-initia
   Running r(options);
   Predictor& p = r.predictor;
   // The object was moved (or the tracker locked onto something else): a consistent 0.4 m jump.
-  const Eigen::Isometry3d jump = se3_exp((Vector6d() << 0.4, 0, 0, 0, 0, 0).finished());
+  const Eigen::Isometry3d jump = geometry::se3_exp((Vector6d() << 0.4, 0, 0, 0, 0, 0).finished());
   for (int i = 0; i < 3; ++i) {
     const double t = 0.45 + 0.01 * i;
     CHECK(p.add_vision(t, jump * r.traj.at(t).x.cam_T_obj(), pose_cov(0.003, 0.004)).verdict == VisionVerdict::Gated);

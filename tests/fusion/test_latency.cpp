@@ -4,9 +4,11 @@
 #include <catch2/catch.hpp>
 
 #include "epichead/fusion/predictor.h"
+#include "epichead/geometry/se3.h"
 #include "truth_helpers.h"
 
 using namespace epichead::fusion;
+namespace geometry = epichead::geometry;
 using namespace epichead::fusion::testing;
 
 namespace {
@@ -120,7 +122,7 @@ TEST_CASE("predict follows the truth between samples and beyond the newest, with
   auto pose_error = [&](double t) {
     const auto p = predictor->predict(t);
     REQUIRE(p);
-    return se3_log(traj.at(t).x.cam_T_obj() * p->cam_T_obj.inverse());
+    return geometry::se3_log(traj.at(t).x.cam_T_obj() * p->cam_T_obj.inverse());
   };
   // Between samples, inside the buffer.
   const Vector6d between = pose_error(1.9805);

@@ -3,9 +3,11 @@
 #include <catch2/catch.hpp>
 
 #include "epichead/fusion/imu_propagation.h"
+#include "epichead/geometry/so3.h"
 #include "truth_helpers.h"
 
 using namespace epichead::fusion;
+namespace geometry = epichead::geometry;
 using namespace epichead::fusion::testing;
 
 namespace {
@@ -20,7 +22,7 @@ ImuSample exact_sample(const Trajectory& traj, double t, const Eigen::Vector3d& 
 
 TEST_CASE("noiseless propagation reproduces the true trajectory, with a rotated IMU and known biases") {
   TrajectoryParams params;
-  params.cam_R_imu = so3_exp(Eigen::Vector3d(0.3, -1.2, 0.7));
+  params.cam_R_imu = geometry::so3_exp(Eigen::Vector3d(0.3, -1.2, 0.7));
   const Trajectory traj(params);
   const Eigen::Vector3d bg(0.01, -0.02, 0.005), ba(0.1, 0.05, -0.2);
   NavState x = traj.at(0).x;
@@ -49,7 +51,7 @@ TEST_CASE("the block-sparse covariance step equals the dense F P F' + Q") {
   NavState x = traj.at(0.4).x;
   x.gyro_bias_radps = Eigen::Vector3d(0.01, 0.02, -0.03);
   x.accel_bias_mps2 = Eigen::Vector3d(-0.1, 0.2, 0.05);
-  const Eigen::Matrix3d C = so3_exp(Eigen::Vector3d(0.2, 0.1, -0.4));
+  const Eigen::Matrix3d C = geometry::so3_exp(Eigen::Vector3d(0.2, 0.1, -0.4));
   const ImuMount mount{C};
   ImuNoise noise;
   noise.gravity_walk_rad_rths = 1e-3;
@@ -68,10 +70,10 @@ TEST_CASE("the block-sparse covariance step equals the dense F P F' + Q") {
   const Eigen::Vector3d omega = C * (0.5 * (s0.gyro_radps + s1.gyro_radps) - x.gyro_bias_radps);
   const Eigen::Vector3d f_mid = C * (0.5 * (s0.accel_mps2 + s1.accel_mps2) - x.accel_bias_mps2);
   ErrorCovariance F = ErrorCovariance::Identity();
-  F.block<3, 3>(err::theta, err::theta) = so3_exp(omega * dt).transpose();
+  F.block<3, 3>(err::theta, err::theta) = geometry::so3_exp(omega * dt).transpose();
   F.block<3, 3>(err::theta, err::bg) = -C * dt;
   F.block<3, 3>(err::p, err::v) = Eigen::Matrix3d::Identity() * dt;
-  F.block<3, 3>(err::v, err::theta) = -x.obj_R_cam * skew(f_mid) * dt;
+  F.block<3, 3>(err::v, err::theta) = -x.obj_R_cam * geometry::skew(f_mid) * dt;
   F.block<3, 3>(err::v, err::ba) = -x.obj_R_cam * C * dt;
   F.block<3, 2>(err::v, err::grav) = gravity_jacobian(x) * dt;
   ErrorVector q;
@@ -90,7 +92,7 @@ TEST_CASE("the transition matches numerical differentiation of the nominal step"
   const Trajectory traj;
   NavState x = traj.at(1.0).x;
   x.gyro_bias_radps = Eigen::Vector3d(0.01, 0.02, -0.03);
-  const ImuMount mount{so3_exp(Eigen::Vector3d(0.2, 0.1, -0.4))};
+  const ImuMount mount{geometry::so3_exp(Eigen::Vector3d(0.2, 0.1, -0.4))};
   const ImuSample s0{1.0, Eigen::Vector3d(0.5, -1.0, 2.0), Eigen::Vector3d(1.0, -9.0, 2.0)};
   const ImuSample s1{1.01, Eigen::Vector3d(0.5, -1.0, 2.0), Eigen::Vector3d(1.0, -9.0, 2.0)};
   NavState ref = x;

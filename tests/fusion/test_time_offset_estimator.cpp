@@ -3,10 +3,11 @@
 #include <cmath>
 #include <random>
 
-#include "epichead/fusion/lie.h"
 #include "epichead/fusion/time_offset_estimator.h"
+#include "epichead/geometry/so3.h"
 
 using namespace epichead::fusion;
+namespace geometry = epichead::geometry;
 
 namespace {
 
@@ -44,14 +45,14 @@ void feed(TimeOffsetEstimator& e, const Feed& f, std::uint32_t seed = 1) {
     if (t >= next_pose - 1e-12) {
       next_pose += 1.0 / 30;
       ++poses;
-      Eigen::Matrix3d noisy = obj_R_cam * so3_exp(f.pose_noise_rad * Eigen::Vector3d(n(rng), n(rng), n(rng)));
+      Eigen::Matrix3d noisy = obj_R_cam * geometry::so3_exp(f.pose_noise_rad * Eigen::Vector3d(n(rng), n(rng), n(rng)));
       if (f.wrong_pose_every > 0 && poses % f.wrong_pose_every == 0)
-        noisy = noisy * so3_exp(f.wrong_pose_rad * Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized());
+        noisy = noisy * geometry::so3_exp(f.wrong_pose_rad * Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized());
       Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
       cam_T_obj.linear() = noisy.transpose();
       e.add_pose(t, cam_T_obj);
     }
-    obj_R_cam = obj_R_cam * so3_exp(w * dt);
+    obj_R_cam = obj_R_cam * geometry::so3_exp(w * dt);
   }
 }
 
@@ -102,7 +103,7 @@ TEST_CASE("time offset: clean data loses no pairs to the outlier pass", "[fusion
 
 TEST_CASE("time offset: the IMU's mounting rotation is applied before comparing", "[fusion][time_offset]") {
   TimeOffsetOptions o;
-  o.cam_R_imu = so3_exp(Eigen::Vector3d(0, 0, M_PI / 2));
+  o.cam_R_imu = geometry::so3_exp(Eigen::Vector3d(0, 0, M_PI / 2));
   auto e = TimeOffsetEstimator::create(o);
   REQUIRE(e);
   Feed f;

@@ -86,7 +86,7 @@ Eigen::Isometry3d noisy_pose(const Eigen::Isometry3d& cam_T_obj, const Matrix6d&
   Vector6d z;
   for (int i = 0; i < 6; ++i) z[i] = n01(rng);
   const Matrix6d L = cov.llt().matrixL();
-  return se3_exp(L * z) * cam_T_obj;
+  return geometry::se3_exp(L * z) * cam_T_obj;
 }
 
 Matrix6d pose_cov(double sigma_m, double sigma_rad) {

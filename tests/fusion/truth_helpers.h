@@ -9,10 +9,13 @@
 #include <Eigen/Geometry>
 
 #include "epichead/fusion/imu_sample.h"
-#include "epichead/fusion/lie.h"
 #include "epichead/fusion/nav_state.h"
+#include "epichead/geometry/se3.h"
 
 namespace epichead::fusion::testing {
+
+using geometry::Matrix6d;
+using geometry::Vector6d;
 
 // Sinusoidal Z-Y-X angles and position about a base pose looking at the object.
 struct TrajectoryParams {

@@ -30,8 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto& cam = config->camera;
   check(cam.width >= 1 && cam.width <= 65535 && cam.height >= 1 && cam.height <= 65535, "image size out of range");
   check(cam.frame_rate_hz >= 0 && cam.frame_rate_hz <= 1e6, "frame rate out of range");
-  check(config->backlash.pan_rad >= 0 && config->backlash.pan_rad <= 1 && config->backlash.tilt_rad >= 0 &&
-            config->backlash.tilt_rad <= 1,
+  const auto& backlash = config->controller.backlash;
+  check(backlash.pan_rad >= 0 && backlash.pan_rad <= 1 && backlash.tilt_rad >= 0 && backlash.tilt_rad <= 1,
         "backlash out of range");
   return 0;
 }

@@ -1,14 +1,11 @@
 // The drivers' per-frame and per-sample paths make no heap allocation after start-up (STYLE.md:
-// hot paths). Counted here, against the fake kernels, by replacing the global operator new in
-// this test executable; timing is left to benchmarks.
+// hot paths). Counted here, against the fake kernels, with the replaced global operator new of
+// common/allocation_counter.h; timing is left to benchmarks.
 #include <catch2/catch.hpp>
 
 #include <linux/can/error.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
+#include "epichead/common/allocation_counter.h"
 #include "epichead/firmware_iface/hid_imu_report.h"
 #include "epichead/hw/fake_clock.h"
 #include "epichead/hw/hid_imu_reader.h"
@@ -17,42 +14,6 @@
 #include "fake_can_kernel.h"
 #include "fake_hid_device.h"
 #include "fake_v4l2_kernel.h"
-
-namespace {
-std::atomic<unsigned long long> g_allocations{0};
-
-// Every form of global new counts; all memory comes from malloc (aligned forms from
-// aligned_alloc), so every form of delete is free().
-void* counted(std::size_t size, std::size_t align = 0) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  const std::size_t n = size == 0 ? 1 : size;
-  void* p = align > alignof(std::max_align_t) ? std::aligned_alloc(align, (n + align - 1) / align * align) : std::malloc(n);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* counted_nothrow(std::size_t size) noexcept {
-  try {
-    return counted(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-}  // namespace
-
-void* operator new(std::size_t n) { return counted(n); }
-void* operator new[](std::size_t n) { return counted(n); }
-void* operator new(std::size_t n, std::align_val_t a) { return counted(n, static_cast<std::size_t>(a)); }
-void* operator new[](std::size_t n, std::align_val_t a) { return counted(n, static_cast<std::size_t>(a)); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted_nothrow(n); }
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted_nothrow(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 using namespace epichead::hw;
 using namespace epichead::testing;
@@ -69,12 +30,12 @@ TEST_CASE("receiving CAN frames, error frames and drop counts allocates nothing"
   CanFrame out_frame;
   out_frame.len = 8;
   StampedCanFrame got;
-  const auto before = g_allocations.load();
+  const auto before = epichead::common::allocation_count();
   int frames = 0;
   while ((*bus)->receive(got, 0) == CanReceive::Frame) ++frames;
   int sent = 0;
   for (int i = 0; i < 100; ++i) sent += (*bus)->send(out_frame).has_value() ? 1 : 0;
-  const auto after = g_allocations.load();  // before any assertion: Catch itself allocates
+  const auto after = epichead::common::allocation_count();  // before any assertion: Catch itself allocates
   CHECK(frames == 1000);
   CHECK(sent == 100);
   CHECK(after - before == 0);
@@ -90,10 +51,10 @@ TEST_CASE("streaming V4L2 frames allocates nothing", "[hw][v4l2][alloc]") {
   REQUIRE((*camera)->start());
   kernel.frames_available = 300;
   CameraFrame frame;
-  const auto before = g_allocations.load();
+  const auto before = epichead::common::allocation_count();
   int frames = 0;
   while ((*camera)->next_frame(frame, 0) == CameraRead::Frame) ++frames;
-  const auto after = g_allocations.load();
+  const auto after = epichead::common::allocation_count();
   CHECK(frames == 300);
   CHECK(after - before == 0);
 }
@@ -113,10 +74,10 @@ TEST_CASE("reading HID IMU samples allocates nothing", "[hw][hid][alloc]") {
     hid.reports.emplace_back(report->bytes.begin(), report->bytes.end());
   }
   ImuReading reading;
-  const auto before = g_allocations.load();
+  const auto before = epichead::common::allocation_count();
   int samples = 0;
   while ((*reader)->receive(reading, 0) == ImuRead::Sample) ++samples;
-  const auto after = g_allocations.load();
+  const auto after = epichead::common::allocation_count();
   CHECK(samples == 500);
   CHECK(after - before == 0);
 }

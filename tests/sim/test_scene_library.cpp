@@ -47,8 +47,10 @@ TEST_CASE("every built-in scene builds and its model file matches the model buil
     CHECK(scene->name == name);
     CHECK(scene->world_T_obj.isApprox(Eigen::Isometry3d::Identity()));
     CHECK(scene->model.warnings.empty());
-    // The committed CAO file (what a sequence's model.cao is copied from).
-    auto from_file = vision::load_cao(sim::scene_model_path(name));
+    // The committed CAO file as built into the program (what a sequence's model.cao is).
+    const auto cao = sim::scene_model_cao(name);
+    REQUIRE(cao);
+    auto from_file = vision::parse_cao(std::string(*cao), name + ".cao");
     REQUIRE(from_file);
     const vision::CadModel& a = scene->model;
     const vision::CadModel& b = *from_file;

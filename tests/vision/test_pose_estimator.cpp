@@ -5,9 +5,11 @@
 #include <cmath>
 #include <random>
 
+#include "epichead/geometry/se3.h"
 #include "epichead/vision/pose_estimator.h"
 
 using namespace epichead::vision;
+namespace geometry = epichead::geometry;
 
 namespace {
 
@@ -54,7 +56,7 @@ LineObservation observe_line(int id, const Eigen::Vector3d& a, const Eigen::Vect
 Eigen::Isometry3d perturb(const Eigen::Isometry3d& pose, double trans_m, double rot_rad) {
   Eigen::Matrix<double, 6, 1> xi;
   xi << trans_m, -trans_m, 0.5 * trans_m, rot_rad, -0.5 * rot_rad, rot_rad;
-  return apply_left(xi, pose);
+  return geometry::apply_left(xi, pose);
 }
 
 double rotation_error_rad(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {

@@ -11,10 +11,12 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "epichead/geometry/se3.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
 
 using namespace epichead::vision;
+namespace geometry = epichead::geometry;
 
 namespace {
 
@@ -155,7 +157,7 @@ Eigen::Isometry3d turned_prior(const Scene& s, double angle_rad) {
   Vector6d xi;
   xi << 0.003, -0.002, 0.004, 0.6 * kDeg, -0.4 * kDeg, 0.5 * kDeg;
   xi -= xi.dot(u) * u;
-  return apply_left(xi, base);
+  return geometry::apply_left(xi, base);
 }
 
 }  // namespace

@@ -7,10 +7,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "epichead/geometry/se3.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
 
 using namespace epichead::vision;
+namespace geometry = epichead::geometry;
 
 namespace {
 
@@ -191,7 +193,7 @@ TEST_CASE("the revolution twist turns the pose about the object's axis to first 
   const Eigen::Isometry3d obj_T_turned = Eigen::Translation3d(axis.point_obj) * Eigen::AngleAxisd(theta, axis.direction_obj) *
                                          Eigen::Translation3d(-axis.point_obj);
   const Eigen::Isometry3d expected = cam_T_obj * obj_T_turned;
-  const Eigen::Isometry3d got = apply_left(theta * u, cam_T_obj);
+  const Eigen::Isometry3d got = geometry::apply_left(theta * u, cam_T_obj);
   const double moved_m = (expected.translation() - cam_T_obj.translation()).norm();
   REQUIRE(moved_m > 1e-8);  // the turn does move the origin
   CHECK((got.translation() - expected.translation()).norm() < 1e-9 * cam_T_obj.translation().norm());

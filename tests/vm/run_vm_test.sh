@@ -167,10 +167,8 @@ if [[ " $phases " == *" onboard "* ]]; then
   cp "$here/onboard_phase.sh" "$root/etc/"
   mkdir -p "$root/etc/onboard"
   cp "$here/onboard/"* "$root/etc/onboard/"
+  # The tracker's model file; the simulator's scenarios and scenes are built into the program.
   cp "$repo/sim/scenes/mockup_walk.cao" "$root/etc/onboard/model.cao"
-  # The simulator finds its scenarios and scenes by the source tree's path compiled into it.
-  mkdir -p "$root$repo/sim"
-  cp -r "$repo/sim/scenes" "$repo/sim/scenarios" "$root$repo/sim/"
 fi
 
 cat >"$root/etc/vm-test.conf" <<EOF

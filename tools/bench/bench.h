@@ -1,7 +1,7 @@
 #pragma once
 // The project's benchmarks, run by `epichead bench`. A benchmark registers a factory that does
 // its set-up (allocation allowed there) and returns the body of one iteration; the harness warms
-// the body up, then times it and counts the heap allocations it makes.
+// the body up, then times it and counts the heap allocations it makes (common/allocation_counter.h).
 //
 //   static const epichead::bench::Registration reg{"visibility_teabox", [] {
 //     auto state = std::make_shared<...>(...);            // set-up
@@ -33,8 +33,5 @@ struct Registration {
     registry().push_back({std::move(name), std::move(make), items});
   }
 };
-
-// Heap allocations made by this process so far (operator new, all threads).
-unsigned long long allocation_count();
 
 }  // namespace epichead::bench

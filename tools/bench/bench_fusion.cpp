@@ -7,6 +7,7 @@
 
 #include "bench/bench.h"
 #include "epichead/fusion/predictor.h"
+#include "epichead/geometry/so3.h"
 
 namespace epichead::bench {
 namespace {
@@ -28,7 +29,7 @@ std::shared_ptr<FusionBench> make_bench() {
   auto created = Predictor::create(PredictorOptions{});
   if (!created) throw std::runtime_error(created.error());
   b->predictor = std::make_unique<Predictor>(std::move(*created));
-  b->cam_T_obj.linear() = so3_exp(Eigen::Vector3d(0.2, -0.3, 0.1));
+  b->cam_T_obj.linear() = geometry::so3_exp(Eigen::Vector3d(0.2, -0.3, 0.1));
   b->cam_T_obj.translation() = Eigen::Vector3d(0.05, -0.02, 0.8);
   b->cov.diagonal() << 1e-6, 1e-6, 4e-6, 1e-5, 1e-5, 1e-5;
   // Still camera: the accelerometer reads -g in the camera frame (gravity along +y of the object).

@@ -51,6 +51,39 @@ ObjectSide side_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
   return cross > 0 ? ObjectSide::Left : ObjectSide::Right;
 }
 
+// The kind of a model edge at this pose, and which of its faces the object side is on (-1:
+// both); false for an edge not drawn (between two faces turned away on a closed model, or
+// between facets of a smooth surface). face_front: the camera is on a face's outer side;
+// face_seen: ... within the view angle (closed models).
+bool classify_edge(const CadModel& model, const ModelEdge& edge, const std::vector<unsigned char>& face_front,
+                   const std::vector<unsigned char>& face_seen, double cos_crease, EdgeKind& kind, int& side_face) {
+  const int fa = edge.faces[0], fb = edge.faces[1];
+  side_face = -1;
+  if (fa < 0 && fb < 0) {
+    kind = EdgeKind::Wire;
+  } else if (fa < 0 || fb < 0) {
+    kind = EdgeKind::Boundary;
+    side_face = fa >= 0 ? 0 : 1;
+  } else {
+    // Facets of a smooth surface keep the strict front test: their silhouette is where the
+    // surface turns away, however grazing the last facet. Across a sharp edge a face seen
+    // nearly edge-on counts as turned away (VisibilityOptions::max_view_angle_rad).
+    const bool smooth = model.faces[fa].normal_obj.dot(model.faces[fb].normal_obj) > cos_crease;
+    const bool front_a = smooth ? face_front[fa] : face_seen[fa];
+    const bool front_b = smooth ? face_front[fb] : face_seen[fb];
+    if (front_a != front_b) {
+      kind = EdgeKind::Contour;
+      side_face = front_a ? 0 : 1;
+    } else {
+      // Both toward the camera, or both away on an open model (thin sheets seen from behind).
+      if (!front_a && model.closed) return false;
+      if (smooth) return false;
+      kind = EdgeKind::Crease;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 Visibility::Visibility(const CadModel& model, const Camera& camera, const VisibilityOptions& options)
@@ -86,13 +119,20 @@ Visibility::Visibility(const CadModel& model, const Camera& camera, const Visibi
 
 void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) {
   out.clear();
-  const CadModel& model = *model_;
   const Eigen::Matrix3d R = cam_T_obj.linear();
   const Eigen::Vector3d t = cam_T_obj.translation();
   const Eigen::Vector3d camera_obj = -R.transpose() * t;
-  const double near = options_.near_m;
-  const double cos_max_view = std::max(0.0, std::cos(options_.max_view_angle_rad));
+  classify_faces(camera_obj);
+  for (std::size_t i = 0; i < model_->vertices.size(); ++i) vertices_cam_[i] = R * model_->vertices[i] + t;
+  place_occluders(R, t);
+  add_edges(R, t, out);
+  add_limbs(R, t, camera_obj, out);
+  add_circles(R, t, out);
+}
 
+void Visibility::classify_faces(const Eigen::Vector3d& camera_obj) {
+  const CadModel& model = *model_;
+  const double cos_max_view = std::max(0.0, std::cos(options_.max_view_angle_rad));
   for (std::size_t f = 0; f < model.faces.size(); ++f) {
     const auto& face = model.faces[f];
     const double height_m = face.normal_obj.dot(camera_obj) - face.offset_m;
@@ -109,16 +149,18 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
     }
     face_seen_[f] = seen;
   }
-  for (std::size_t i = 0; i < model.vertices.size(); ++i) vertices_cam_[i] = R * model.vertices[i] + t;
+}
 
-  // Occluders. In a closed model a back face is always behind a front face, so front faces
-  // suffice; an open model's faces are thin sheets that hide from both sides.
+// Occluders. In a closed model a back face is always behind a front face, so front faces
+// suffice; an open model's faces are thin sheets that hide from both sides.
+void Visibility::place_occluders(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  const double near = options_.near_m;
   constexpr float kInfF = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < triangles_.size(); ++i) {
     const Triangle& tri = triangles_[i];
     // An empty box (x0 > x1) marks a triangle that hides nothing this call.
     tri_x0_[i] = kInfF; tri_x1_[i] = -kInfF; tri_y0_[i] = kInfF; tri_y1_[i] = -kInfF;
-    if (model.closed && !face_front_[tri.face]) continue;
+    if (model_->closed && !face_front_[tri.face]) continue;
     const Eigen::Vector3d p0 = R * tri.p0 + t, p1 = R * tri.p1 + t, p2 = R * tri.p2 + t;
     const double zmax = std::max({p0.z(), p1.z(), p2.z()});
     if (zmax <= near) continue;  // wholly behind the near plane: hides nothing in view
@@ -135,141 +177,142 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
       tri_x0_[i] = -kInfF; tri_x1_[i] = kInfF; tri_y0_[i] = -kInfF; tri_y1_[i] = kInfF;
     }
   }
+}
 
-  // Clips segment A->B (camera frame) to the near plane and the image frustum; then removes the
-  // parts hidden by triangles (skipping the faces the segment lies on) and emits the pieces.
-  auto emit_segment = [&](const Eigen::Vector3d& A, const Eigen::Vector3d& B, int face_a, int face_b,
-                          int index, EdgeKind kind, const Eigen::Vector3d& side_probe_cam,
-                          bool side_from_probe, const Eigen::Vector3d& A_obj, const Eigen::Vector3d& B_obj) {
-    double lo = 0, hi = 1;
-    clip_linear(A.z(), B.z(), near, lo, hi);
-    clip_linear(A.x() - xn_min_ * A.z(), B.x() - xn_min_ * B.z(), 0, lo, hi);
-    clip_linear(xn_max_ * A.z() - A.x(), xn_max_ * B.z() - B.x(), 0, lo, hi);
-    clip_linear(A.y() - yn_min_ * A.z(), B.y() - yn_min_ * B.z(), 0, lo, hi);
-    clip_linear(yn_max_ * A.z() - A.y(), yn_max_ * B.z() - B.y(), 0, lo, hi);
-    if (!(hi > lo)) return;
-    const Eigen::Vector3d D = B - A;
-    const Eigen::Vector3d P0 = A + lo * D, P1 = A + hi * D;
-    const Eigen::Vector2d n0 = normalized(P0), n1 = normalized(P1);
-    const float bx0 = static_cast<float>(std::min(n0.x(), n1.x())), bx1 = static_cast<float>(std::max(n0.x(), n1.x()));
-    const float by0 = static_cast<float>(std::min(n0.y(), n1.y())), by1 = static_cast<float>(std::max(n0.y(), n1.y()));
+// The interval [lo, hi] of the segment A->B (camera frame) in front of the near plane and inside
+// the image frustum; false if empty.
+bool Visibility::clip_to_view(const Eigen::Vector3d& A, const Eigen::Vector3d& B, double& lo, double& hi) const {
+  lo = 0;
+  hi = 1;
+  clip_linear(A.z(), B.z(), options_.near_m, lo, hi);
+  clip_linear(A.x() - xn_min_ * A.z(), B.x() - xn_min_ * B.z(), 0, lo, hi);
+  clip_linear(xn_max_ * A.z() - A.x(), xn_max_ * B.z() - B.x(), 0, lo, hi);
+  clip_linear(A.y() - yn_min_ * A.z(), B.y() - yn_min_ * B.z(), 0, lo, hi);
+  clip_linear(yn_max_ * A.z() - A.y(), yn_max_ * B.z() - B.y(), 0, lo, hi);
+  return hi > lo;
+}
 
-    // Box rejection over all triangles first: a branch-free loop over contiguous floats that
-    // the compiler vectorises; only the few survivors get the exact test.
-    candidates_.clear();
-    const int count = static_cast<int>(triangles_.size());
-    const float* x0 = tri_x0_.data(); const float* x1 = tri_x1_.data();
-    const float* y0 = tri_y0_.data(); const float* y1 = tri_y1_.data();
-    for (int i = 0; i < count; ++i) {
-      if ((x0[i] <= bx1) & (x1[i] >= bx0) & (y0[i] <= by1) & (y1[i] >= by0)) candidates_.push_back(i);
-    }
-    hidden_.clear();
-    for (const int i : candidates_) {
-      const int face = triangles_[i].face;
-      if (face == face_a || face == face_b) continue;
-      const Eigen::Vector3d& V0 = tri_cam_[3 * i];
-      const Eigen::Vector3d& V1 = tri_cam_[3 * i + 1];
-      const Eigen::Vector3d& V2 = tri_cam_[3 * i + 2];
-      const double det = V0.dot(V1.cross(V2));
-      if (std::abs(det) < 1e-18) continue;  // seen edge-on: hides nothing
-      const double o = det > 0 ? 1.0 : -1.0;
-      double s0 = lo, s1 = hi;
-      // Inside the cone, with a tolerance scaled to the geometry so that an edge running along
-      // an occluder's border is not hidden by round-off.
-      const Eigen::Vector3d c01 = o * V0.cross(V1), c12 = o * V1.cross(V2), c20 = o * V2.cross(V0);
-      const double tol = 1e-9 * (std::abs(det) / (V0.norm() + V1.norm() + V2.norm() + 1e-30));
-      clip_linear(c01.dot(A), c01.dot(B), tol, s0, s1);
-      clip_linear(c12.dot(A), c12.dot(B), tol, s0, s1);
-      clip_linear(c20.dot(A), c20.dot(B), tol, s0, s1);
-      if (!(s1 > s0)) continue;
-      // Behind the triangle's plane by more than a small depth tolerance (touching faces).
-      const Eigen::Vector3d nrm = (V1 - V0).cross(V2 - V0);
-      const double nn = nrm.norm();
-      const Eigen::Vector3d nu = nrm / nn;
-      const double d = nu.dot(V0);
-      const double sgn = d > 0 ? 1.0 : -1.0;
-      const double depth_tol = 1e-6 + 1e-7 * std::abs(d);
-      clip_linear(sgn * (nu.dot(A) - d), sgn * (nu.dot(B) - d), depth_tol, s0, s1);
-      if (s1 > s0) hidden_.emplace_back(s0, s1);
-    }
-    std::sort(hidden_.begin(), hidden_.end());
+// hidden_: the sorted intervals of [lo, hi] of the segment hidden by a triangle of a face other
+// than the segment's own; n0, n1 the clipped ends in normalised coordinates.
+void Visibility::find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1) {
+  const Eigen::Vector3d& A = seg.a_cam;
+  const Eigen::Vector3d& B = seg.b_cam;
+  const float bx0 = static_cast<float>(std::min(n0.x(), n1.x())), bx1 = static_cast<float>(std::max(n0.x(), n1.x()));
+  const float by0 = static_cast<float>(std::min(n0.y(), n1.y())), by1 = static_cast<float>(std::max(n0.y(), n1.y()));
 
-    // A 3D segment projects to a straight one in normalised coordinates: its clipped ends give
-    // the direction the side is measured against.
-    const ObjectSide side = side_from_probe ? side_of(n0, n1, normalized(side_probe_cam)) : ObjectSide::Both;
+  // Box rejection over all triangles first: a branch-free loop over contiguous floats that
+  // the compiler vectorises; only the few survivors get the exact test.
+  candidates_.clear();
+  const int count = static_cast<int>(triangles_.size());
+  const float* x0 = tri_x0_.data(); const float* x1 = tri_x1_.data();
+  const float* y0 = tri_y0_.data(); const float* y1 = tri_y1_.data();
+  for (int i = 0; i < count; ++i) {
+    if ((x0[i] <= bx1) & (x1[i] >= bx0) & (y0[i] <= by1) & (y1[i] >= by0)) candidates_.push_back(i);
+  }
+  hidden_.clear();
+  for (const int i : candidates_) {
+    const int face = triangles_[i].face;
+    if (face == seg.face_a || face == seg.face_b) continue;
+    const Eigen::Vector3d& V0 = tri_cam_[3 * i];
+    const Eigen::Vector3d& V1 = tri_cam_[3 * i + 1];
+    const Eigen::Vector3d& V2 = tri_cam_[3 * i + 2];
+    const double det = V0.dot(V1.cross(V2));
+    if (std::abs(det) < 1e-18) continue;  // seen edge-on: hides nothing
+    const double o = det > 0 ? 1.0 : -1.0;
+    double s0 = lo, s1 = hi;
+    // Inside the cone, with a tolerance scaled to the geometry so that an edge running along
+    // an occluder's border is not hidden by round-off.
+    const Eigen::Vector3d c01 = o * V0.cross(V1), c12 = o * V1.cross(V2), c20 = o * V2.cross(V0);
+    const double tol = 1e-9 * (std::abs(det) / (V0.norm() + V1.norm() + V2.norm() + 1e-30));
+    clip_linear(c01.dot(A), c01.dot(B), tol, s0, s1);
+    clip_linear(c12.dot(A), c12.dot(B), tol, s0, s1);
+    clip_linear(c20.dot(A), c20.dot(B), tol, s0, s1);
+    if (!(s1 > s0)) continue;
+    // Behind the triangle's plane by more than a small depth tolerance (touching faces).
+    const Eigen::Vector3d nrm = (V1 - V0).cross(V2 - V0);
+    const double nn = nrm.norm();
+    const Eigen::Vector3d nu = nrm / nn;
+    const double d = nu.dot(V0);
+    const double sgn = d > 0 ? 1.0 : -1.0;
+    const double depth_tol = 1e-6 + 1e-7 * std::abs(d);
+    clip_linear(sgn * (nu.dot(A) - d), sgn * (nu.dot(B) - d), depth_tol, s0, s1);
+    if (s1 > s0) hidden_.emplace_back(s0, s1);
+  }
+  std::sort(hidden_.begin(), hidden_.end());
+}
 
-    auto push_piece = [&](double s0, double s1) {
-      const Eigen::Vector3d a_cam = A + s0 * D, b_cam = A + s1 * D;
-      const Eigen::Vector2d a_px = camera_.project(a_cam), b_px = camera_.project(b_cam);
-      if ((b_px - a_px).norm() < options_.min_length_px) return;
-      VisibleEdge e;
-      e.edge = index;
-      e.kind = kind;
-      e.side = side;
-      e.a_obj = A_obj + s0 * (B_obj - A_obj);
-      e.b_obj = A_obj + s1 * (B_obj - A_obj);
-      e.a_cam = a_cam;
-      e.b_cam = b_cam;
-      e.a_px = a_px;
-      e.b_px = b_px;
-      e.s0 = s0;
-      e.s1 = s1;
-      out.edges.push_back(e);
-    };
-    double cursor = lo;
-    for (const auto& [h0, h1] : hidden_) {
-      if (h0 > cursor) push_piece(cursor, std::min(h0, hi));
-      cursor = std::max(cursor, h1);
-      if (cursor >= hi) break;
-    }
-    if (cursor < hi) push_piece(cursor, hi);
+// Clips the segment to the view, removes the parts hidden by triangles and emits the visible
+// pieces (each at least min_length_px long).
+void Visibility::emit_segment(const Segment& seg, VisibleModel& out) {
+  double lo = 0, hi = 1;
+  if (!clip_to_view(seg.a_cam, seg.b_cam, lo, hi)) return;
+  const Eigen::Vector3d& A = seg.a_cam;
+  const Eigen::Vector3d D = seg.b_cam - A;
+  const Eigen::Vector3d P0 = A + lo * D, P1 = A + hi * D;
+  const Eigen::Vector2d n0 = normalized(P0), n1 = normalized(P1);
+  find_hidden(seg, lo, hi, n0, n1);
+
+  // A 3D segment projects to a straight one in normalised coordinates: its clipped ends give
+  // the direction the side is measured against.
+  const ObjectSide side = seg.side_from_probe ? side_of(n0, n1, normalized(seg.side_probe_cam)) : ObjectSide::Both;
+
+  auto push_piece = [&](double s0, double s1) {
+    const Eigen::Vector3d a_cam = A + s0 * D, b_cam = A + s1 * D;
+    const Eigen::Vector2d a_px = camera_.project(a_cam), b_px = camera_.project(b_cam);
+    if ((b_px - a_px).norm() < options_.min_length_px) return;
+    VisibleEdge e;
+    e.edge = seg.index;
+    e.kind = seg.kind;
+    e.side = side;
+    e.a_obj = seg.a_obj + s0 * (seg.b_obj - seg.a_obj);
+    e.b_obj = seg.a_obj + s1 * (seg.b_obj - seg.a_obj);
+    e.a_cam = a_cam;
+    e.b_cam = b_cam;
+    e.a_px = a_px;
+    e.b_px = b_px;
+    e.s0 = s0;
+    e.s1 = s1;
+    out.edges.push_back(e);
   };
+  double cursor = lo;
+  for (const auto& [h0, h1] : hidden_) {
+    if (h0 > cursor) push_piece(cursor, std::min(h0, hi));
+    cursor = std::max(cursor, h1);
+    if (cursor >= hi) break;
+  }
+  if (cursor < hi) push_piece(cursor, hi);
+}
 
+// The model's edges: contours, creases, boundaries and wires, each with its object side probed
+// by a point just inside the face the object is on.
+void Visibility::add_edges(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, VisibleModel& out) {
+  const CadModel& model = *model_;
   const double cos_crease = std::cos(options_.crease_angle_rad);
   for (int e = 0; e < static_cast<int>(model.edges.size()); ++e) {
     const ModelEdge& edge = model.edges[e];
-    const int fa = edge.faces[0], fb = edge.faces[1];
     EdgeKind kind;
     int side_face = -1;  // the face whose side the object is on; -1 for Both
-    if (fa < 0 && fb < 0) {
-      kind = EdgeKind::Wire;
-    } else if (fa < 0 || fb < 0) {
-      kind = EdgeKind::Boundary;
-      side_face = fa >= 0 ? 0 : 1;
-    } else {
-      // Facets of a smooth surface keep the strict front test: their silhouette is where the
-      // surface turns away, however grazing the last facet. Across a sharp edge a face seen
-      // nearly edge-on counts as turned away (VisibilityOptions::max_view_angle_rad).
-      const bool smooth = model.faces[fa].normal_obj.dot(model.faces[fb].normal_obj) > cos_crease;
-      const bool front_a = smooth ? face_front_[fa] : face_seen_[fa];
-      const bool front_b = smooth ? face_front_[fb] : face_seen_[fb];
-      if (front_a != front_b) {
-        kind = EdgeKind::Contour;
-        side_face = front_a ? 0 : 1;
-      } else {
-        // Both toward the camera, or both away on an open model (thin sheets seen from behind).
-        if (!front_a && model.closed) continue;
-        if (smooth) continue;
-        kind = EdgeKind::Crease;
-      }
-    }
+    if (!classify_edge(model, edge, face_front_, face_seen_, cos_crease, kind, side_face)) continue;
     const Eigen::Vector3d& A_obj = model.vertices[edge.v0];
     const Eigen::Vector3d& B_obj = model.vertices[edge.v1];
-    const Eigen::Vector3d& A = vertices_cam_[edge.v0];
-    const Eigen::Vector3d& B = vertices_cam_[edge.v1];
     Eigen::Vector3d probe = Eigen::Vector3d::Zero();
     if (side_face >= 0) {
       // A point just inside the face, beside the middle of the edge.
       const double len = (B_obj - A_obj).norm();
       probe = R * (0.5 * (A_obj + B_obj) + 1e-2 * len * edge.into_face[side_face]) + t;
-      if (probe.z() <= near) side_face = -1;
+      if (probe.z() <= options_.near_m) side_face = -1;
     }
-    emit_segment(A, B, fa, fb, e, kind, probe, side_face >= 0, A_obj, B_obj);
+    emit_segment({vertices_cam_[edge.v0], vertices_cam_[edge.v1], A_obj, B_obj, edge.faces[0], edge.faces[1], e, kind,
+                  probe, side_face >= 0},
+                 out);
   }
+}
 
-  // Cylinder limbs: the two generators whose tangent planes pass through the optical centre.
-  for (int c = 0; c < static_cast<int>(model.cylinders.size()); ++c) {
-    const ModelCylinder& cyl = model.cylinders[c];
+// Cylinder limbs: the two generators whose tangent planes pass through the optical centre.
+void Visibility::add_limbs(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Eigen::Vector3d& camera_obj,
+                           VisibleModel& out) {
+  for (int c = 0; c < static_cast<int>(model_->cylinders.size()); ++c) {
+    const ModelCylinder& cyl = model_->cylinders[c];
     const Eigen::Vector3d a_obj = cyl.axis_a_obj, b_obj = cyl.axis_b_obj;
     const Eigen::Vector3d axis_obj = (b_obj - a_obj).normalized();
     Eigen::Vector3d w = camera_obj - a_obj;
@@ -284,21 +327,24 @@ void Visibility::compute(const Eigen::Isometry3d& cam_T_obj, VisibleModel& out) 
       const Eigen::Vector3d offset = cyl.radius_m * (cos_phi * u + sign * sin_phi * v);
       const Eigen::Vector3d p_obj = a_obj + offset, q_obj = b_obj + offset;
       const Eigen::Vector3d probe = R * (0.5 * (a_obj + b_obj)) + t;  // the axis is on the object side
-      emit_segment(R * p_obj + t, R * q_obj + t, -1, -1, c, EdgeKind::CylinderSilhouette, probe,
-                   probe.z() > near, p_obj, q_obj);
+      emit_segment({R * p_obj + t, R * q_obj + t, p_obj, q_obj, -1, -1, c, EdgeKind::CylinderSilhouette, probe,
+                    probe.z() > options_.near_m},
+                   out);
     }
   }
+}
 
-  // Circles: the image of the circle c + r (u cos th + v sin th) is the conic
-  // C = H^-T diag(1, 1, -1) H^-1 with H = K [r u, r v, c]; inside is negative.
+// Circles: the image of the circle c + r (u cos th + v sin th) is the conic
+// C = H^-T diag(1, 1, -1) H^-1 with H = K [r u, r v, c]; inside is negative.
+void Visibility::add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, VisibleModel& out) {
   const Eigen::Matrix3d K = camera_.K();
-  for (int i = 0; i < static_cast<int>(model.circles.size()); ++i) {
-    const ModelCircle& circle = model.circles[i];
+  for (int i = 0; i < static_cast<int>(model_->circles.size()); ++i) {
+    const ModelCircle& circle = model_->circles[i];
     const Eigen::Vector3d c = R * circle.centre_obj + t;
     const Eigen::Vector3d n = (R * circle.normal_obj).normalized();
     // The lowest depth on the circle: c_z - r * |z axis projected on the plane|.
     const double zmin = c.z() - circle.radius_m * std::sqrt(std::max(0.0, 1 - n.z() * n.z()));
-    if (zmin <= near) continue;
+    if (zmin <= options_.near_m) continue;
     if (std::abs(n.dot(c)) < 1e-9 * c.norm()) continue;  // seen edge-on: degenerate
     Eigen::Vector3d u = n.unitOrthogonal();
     Eigen::Vector3d v = n.cross(u);

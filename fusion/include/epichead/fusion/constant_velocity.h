@@ -1,10 +1,14 @@
 #pragma once
 // The fallback without IMU: a Kalman filter on vision poses alone with a constant twist
 // (angular rate in the camera frame, velocity in the object frame) driven by white acceleration.
+// The Predictor's filter in Mode::ConstantVelocity, behind the same PoseFilter interface as the
+// IMU filter.
+#include <optional>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "epichead/fusion/lie.h"
+#include "epichead/fusion/pose_filter.h"
 #include "epichead/fusion/pose_prediction.h"
 #include "epichead/fusion/pose_update.h"
 
@@ -17,7 +21,7 @@ struct ConstantVelocityNoise {
   double initial_rate_radps = 2.0;   // 1-sigma of the unknown angular rate at initialisation
 };
 
-class ConstantVelocityFilter {
+class ConstantVelocityFilter final : public PoseFilter {
  public:
   // Error state: orientation (local), position, velocity, angular rate.
   static constexpr int dim = 12;
@@ -25,14 +29,16 @@ class ConstantVelocityFilter {
 
   explicit ConstantVelocityFilter(const ConstantVelocityNoise& noise = {}) : noise_(noise) {}
 
-  // Starts at the pose at t_s, at rest with the configured uncertainty of the twist.
-  void initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
-  // Moves the state to t_s (t_s >= time()) and applies the gated pose update.
-  PoseUpdateResult update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov, double gate_chi2);
-  // The pose at any t_s, extrapolated with the current twist.
-  PosePrediction predict(double t_s) const;
+  // Starts at the pose at t_s, at rest with the configured uncertainty of the twist (always true).
+  bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) override;
+  // Moves the state to t_s (t_s >= update_t_s()) and applies the gated pose update (never empty).
+  std::optional<PoseUpdateResult> update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
+                                         double gate_chi2) override;
+  // The pose at any t_s, extrapolated with the current twist (never empty).
+  std::optional<PosePrediction> predict(double t_s) const override;
+  double update_t_s() const override { return t_s_; }
+  void reset() override {}  // initialise() sets every member
 
-  double time() const { return t_s_; }
   const Eigen::Vector3d& obj_v_cam() const { return obj_v_cam_; }
   const Eigen::Vector3d& omega_cam_radps() const { return omega_cam_radps_; }
 

@@ -1,12 +1,10 @@
 #pragma once
 // The filter's nominal state, its 17-dimensional error state and the maps between them.
 // Conventions (docs/fusion.md): the object frame is inertial (the object is static); orientation
-// error is local, obj_R_cam_true = obj_R_cam * so3_exp(dtheta); position, velocity and biases have
+// error is local, obj_R_cam_true = obj_R_cam * geometry::so3_exp(dtheta); position, velocity and biases have
 // additive errors; gravity is a direction of fixed magnitude with a 2-dof local error.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
-#include "epichead/fusion/lie.h"
 
 namespace epichead::fusion {
 

@@ -2,9 +2,12 @@
 // A predicted camera pose for window placement.
 #include <Eigen/Geometry>
 
-#include "epichead/fusion/lie.h"
+#include "epichead/geometry/se3.h"
 
 namespace epichead::fusion {
+
+using geometry::Matrix6d;
+using geometry::Vector6d;
 
 struct PosePrediction {
   double t_s = 0;

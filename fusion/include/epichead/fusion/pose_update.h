@@ -1,10 +1,13 @@
 #pragma once
 // The vision update: a measured cam_T_obj with the covariance of its left perturbation
 // (translation, rotation), exactly what vision::PoseEstimator returns. Mahalanobis-gated.
-#include "epichead/fusion/lie.h"
+#include "epichead/geometry/se3.h"
 #include "epichead/fusion/nav_state.h"
 
 namespace epichead::fusion {
+
+using geometry::Matrix6d;
+using geometry::Vector6d;
 
 struct PoseUpdateResult {
   bool applied = false;     // false: gated (state untouched)

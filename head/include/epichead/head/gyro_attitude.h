@@ -3,12 +3,12 @@
 // fixed at the first sample (it drifts with the gyro bias, a few mrad/s at most; the
 // controllers only use it over short spans or close the loop through vision), and a fixed
 // ring of past orientations so a target direction seen at a frame's exposure time can be
-// carried to now. Sized once; no allocation per sample.
-#include <cstddef>
-#include <vector>
+// carried to now (a new sample overwrites the oldest). Sized once; no allocation per sample.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "epichead/common/ring_buffer.h"
 
 namespace epichead::head {
 
@@ -24,7 +24,7 @@ class GyroAttitude {
   // than the previous one.
   bool add(double t_s, const Eigen::Vector3d& gyro_radps, double max_gap_s);
 
-  bool empty() const { return count_ == 0; }
+  bool empty() const { return ring_.empty(); }
   double newest_t_s() const;
   // inertial_R_cam at the newest sample.
   const Eigen::Quaterniond& newest() const { return newest_; }
@@ -39,10 +39,7 @@ class GyroAttitude {
     double t_s = 0;
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   };
-  const Entry& entry(std::size_t i_from_oldest) const;  // 0 = oldest
-  std::vector<Entry> ring_;
-  std::size_t head_ = 0;   // next write position
-  std::size_t count_ = 0;
+  common::RingBuffer<Entry> ring_;
   Eigen::Quaterniond newest_ = Eigen::Quaterniond::Identity();
 };
 

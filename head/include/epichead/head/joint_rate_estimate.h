@@ -13,10 +13,11 @@
 // that rate through the same delay and lag, while the correction still compares the motor-side
 // model with the measurement (the encoder is on the motor).
 // Fixed storage, no allocation.
-#include <array>
 #include <cstddef>
 
 #include <Eigen/Core>
+
+#include "epichead/common/ring_buffer.h"
 
 namespace epichead::head {
 
@@ -67,9 +68,8 @@ class JointRateEstimate {
   }
 
   JointRateEstimateOptions options_;
-  static constexpr std::size_t kCapacity = 64;  // 64 ms at 1 kHz: more than any delay asked for
-  std::array<Sent, kCapacity> sent_{};
-  std::size_t newest_ = 0, count_ = 0;
+  // The commands sent, a new one overwriting the oldest: 64 ms at 1 kHz, more than any delay asked for.
+  common::RingBuffer<Sent, 64> sent_;
   bool have_measured_ = false;
   double measured_t_s_ = 0;
   Eigen::Vector2d measured_ = Eigen::Vector2d::Zero();

@@ -1,6 +1,7 @@
 #pragma once
 // An edge-detecting input port (the IMU's sync pulse): waits for the next edge and says when it
-// happened, stamped by the kernel (Linux: CLOCK_MONOTONIC in ns) or by the simulator.
+// happened, stamped by the kernel (Linux: CLOCK_MONOTONIC, given in ns and converted here to the
+// program's seconds, docs/time.md) or by the simulator.
 #include <cstdint>
 #include <string_view>
 
@@ -9,7 +10,7 @@ namespace epichead::hw {
 enum class GpioEdgeKind { Rising, Falling };
 
 struct GpioEdge {
-  std::int64_t timestamp_ns = 0;
+  double t_s = 0;  // CLOCK_MONOTONIC seconds, as hw::MonotonicClock
   GpioEdgeKind kind = GpioEdgeKind::Rising;
 };
 

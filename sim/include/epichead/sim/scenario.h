@@ -88,9 +88,9 @@ struct Scenario {
 // directory. Every error is "name:line: what".
 std::expected<Scenario, std::string> parse_scenario(const std::string& text, const std::string& name);
 std::expected<Scenario, std::string> load_scenario(const std::string& path);
-// A built-in name (mockup_walk, lampshade, box_clutter, office_pan, can, bowl) or a path to a .scn file.
+// A built-in name (mockup_walk, lampshade, box_clutter, office_pan, can, bowl: sim/scenarios,
+// built into the program) or a path to a .scn file.
 std::expected<Scenario, std::string> find_scenario(const std::string& name_or_path);
 const std::vector<std::string>& builtin_scenario_names();
-std::string scenarios_dir();  // sim/scenarios in the source tree
 
 }  // namespace epichead::sim

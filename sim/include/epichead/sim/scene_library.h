@@ -25,6 +25,7 @@
 //                apart, below the crease angle) and the open top's rim circle.
 #include <cstdint>
 #include <expected>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -36,19 +37,18 @@ namespace epichead::sim {
 // The names make_scene accepts, in the order above.
 const std::vector<std::string>& scene_names();
 
-// Builds a built-in scene (model, meshes, procedural textures; photos from scenes_dir()).
+// Builds a built-in scene (model, meshes, procedural textures; photos built into the program).
 // `print_seed` 0 gives the object's built-in procedural prints (package faces, label, plates),
 // any other value a different set (scene variety). Errors name the unknown scene (with the
 // known ones) or the photo that could not be read.
 std::expected<Scene, std::string> make_scene(std::string_view name, std::uint64_t print_seed = 0);
 
-// The tracked object's wire-frame of a built-in scene, as written to scenes_dir()/<name>.cao
+// The tracked object's wire-frame of a built-in scene, as written to sim/scenes/<name>.cao
 // (a sequence's model.cao is a copy of that file).
 std::expected<vision::CadModel, std::string> make_scene_model(std::string_view name);
 
-// Directory with the built-in assets (sim/scenes in the source tree).
-std::string scenes_dir();
-// Path of a built-in scene's CAO file: scenes_dir()/<name>.cao.
-std::string scene_model_path(std::string_view name);
+// The text of a built-in scene's CAO file (sim/scenes/<name>.cao, built into the program); a
+// tool that needs the model as a file writes this text. nullopt for an unknown scene.
+std::optional<std::string_view> scene_model_cao(std::string_view name);
 
 }  // namespace epichead::sim

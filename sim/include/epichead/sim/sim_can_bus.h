@@ -15,11 +15,11 @@
 #include <optional>
 #include <string>
 
+#include "epichead/common/ring_buffer.h"
 #include "epichead/hw/can_bus.h"
 #include "epichead/hw/clock.h"
 #include "epichead/sim/bus_timing.h"
 #include "epichead/sim/fault_plan.h"
-#include "epichead/sim/ring_queue.h"
 
 namespace epichead::sim {
 
@@ -69,7 +69,8 @@ class SimCanBus final : public hw::CanBus {
   const hw::Clock& clock_;
   std::function<void(double)> advance_;
   std::uint64_t seed_, draws_ = 0;  // one Random(seed, stream, draws_++) per frame
-  RingQueue<InFlight> to_host_, to_nodes_;
+  // Queues that refuse a frame when full (try_push): a full queue is a dropped frame, counted.
+  common::RingBuffer<InFlight> to_host_, to_nodes_;
   double last_arrival_s_ = 0;
   hw::CanBusStats stats_;
   SimBusCounters counters_;

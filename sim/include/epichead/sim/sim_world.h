@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 
+#include "epichead/common/ring_buffer.h"
 #include "epichead/hw/camera_port.h"
 #include "epichead/hw/can_bus.h"
 #include "epichead/hw/clock.h"
@@ -113,8 +114,9 @@ class SimWorld {
   std::unique_ptr<SimHeadNode> head_;
   std::unique_ptr<SimImuNode> imu_;
   std::unique_ptr<SimCamera> camera_;
-  // Servo ticks, newest last, kept for history_s (truth_at, the camera's exposures).
-  RingQueue<HeadTick> history_;
+  // Servo ticks, newest last, kept for history_s (truth_at, the camera's exposures); a new tick
+  // overwrites the oldest.
+  common::RingBuffer<HeadTick> history_;
   std::int64_t tick_index_ = 0;   // next servo tick: tick_index_ / servo_rate_hz
   std::int64_t state_index_ = 0, status_index_ = 0, imu_beat_index_ = 0, head_beat_index_ = 0;
   SimWorldStats stats_;

@@ -81,6 +81,27 @@ class Visibility {
   const VisibilityOptions& options() const { return options_; }
 
  private:
+  // A segment to clip and emit: its ends in the camera and object frames, the faces it lies on
+  // (not occluders of it; -1 for none), what it is, and the point that tells the object side.
+  struct Segment {
+    Eigen::Vector3d a_cam, b_cam, a_obj, b_obj;
+    int face_a, face_b;
+    int index;  // VisibleEdge::edge
+    EdgeKind kind;
+    Eigen::Vector3d side_probe_cam;
+    bool side_from_probe;
+  };
+  // The stages of compute(), in order.
+  void classify_faces(const Eigen::Vector3d& camera_obj);
+  void place_occluders(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+  void add_edges(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, VisibleModel& out);
+  void add_limbs(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Eigen::Vector3d& camera_obj, VisibleModel& out);
+  void add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, VisibleModel& out);
+  // Clipping of one segment: to the view, then by the occluders, then its visible pieces.
+  bool clip_to_view(const Eigen::Vector3d& A, const Eigen::Vector3d& B, double& lo, double& hi) const;
+  void find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1);
+  void emit_segment(const Segment& seg, VisibleModel& out);
+
   const CadModel* model_;
   Camera camera_;
   VisibilityOptions options_;

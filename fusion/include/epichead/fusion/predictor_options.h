@@ -1,0 +1,44 @@
+#pragma once
+// What the Predictor is told: which motion model, the IMU's noise, mount, clock offset and range,
+// how late a vision pose may be, the gates and the start-up uncertainties.
+#include <Eigen/Core>
+
+#include "epichead/fusion/constant_velocity.h"
+#include "epichead/fusion/imu_propagation.h"
+
+namespace epichead::fusion {
+
+enum class PredictorMode { ImuAided, ConstantVelocity };
+
+struct PredictorOptions {
+  PredictorMode mode = PredictorMode::ImuAided;
+  ImuNoise imu_noise;
+  ImuMount mount;                       // cam_R_imu
+  double imu_time_offset_s = 0;         // t_camera = t_imu - offset
+  // 1-sigma of imu_time_offset_s. A vision pose's time on the IMU clock is then uncertain by this
+  // much, so its covariance grows by the pose's own motion over that time (rate x sigma): while
+  // the camera turns fast, a pose from a clock that may be 20 ms off is no better than ~1 deg,
+  // however sharp the image. 0: the offset is exact.
+  double imu_time_offset_sigma_s = 0;
+  double imu_rate_hz = 1000;            // nominal; sizes the ring
+  double buffer_s = 0.5;                // how late a vision pose may be
+  double gyro_range_radps = 1e300;      // a reading at or beyond +-range on any axis is saturated
+  double accel_range_mps2 = 1e300;
+  double dropout_gap_s = 0.0035;        // a gap between samples longer than this is a dropout
+  // Over a gap the readings are unknown, not linear: the error covariance of a step longer than
+  // dropout_gap_s (and of an extrapolation that long) grows by a random rate and acceleration of
+  // these sizes held over the step (docs/fusion.md).
+  double dropout_gyro_sigma_radps = 1.0;
+  double dropout_accel_sigma_mps2 = 2.0;
+  double coast_after_s = 0.02;          // status().coasting when the newest sample is older than this
+  double gate_chi2 = 22.46;             // chi-square, 6 dof, p = 0.999
+  int reinit_after_gated = 5;           // this many gated poses in a row: re-initialise on the next
+  double gravity_average_s = 0.1;       // accelerometer averaging window before the first pose
+  double initial_gravity_rad = 0.05;    // 1-sigma of the gravity direction at init (plus motion, see docs)
+  double initial_speed_mps = 0.5;       // 1-sigma of the velocity at init
+  double initial_gyro_bias_radps = 0.02;
+  double initial_accel_bias_mps2 = 0.2;
+  ConstantVelocityNoise cv_noise;       // Mode::ConstantVelocity
+};
+
+}  // namespace epichead::fusion

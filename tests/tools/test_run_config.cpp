@@ -1,0 +1,70 @@
+// The `epichead run --config` reader: the controller's gains come from the file, a gain the
+// controller does not have or out of its range is an error naming it, and --help lists them.
+#include <catch2/catch_test_macros.hpp>
+
+#include "common/run_tool.h"
+#include "common/temp_dir.h"
+#include "run_config.h"
+
+namespace {
+
+using epichead::testing::TempDir;
+using epichead::tools::read_run_config;
+
+constexpr const char* kFiles = R"("model": "m.cao", "camera_calibration": "c.yaml", "init_pose": "i.csv")";
+
+std::string write_config(const TempDir& dir, const std::string& extra) {
+  return dir.write("robot.json", std::string("{ ") + kFiles + (extra.empty() ? "" : ", " + extra) + " }");
+}
+
+}  // namespace
+
+TEST_CASE("run config: the controller's defaults stand when the file gives no gains") {
+  TempDir dir;
+  const auto c = read_run_config(write_config(dir, ""));
+  REQUIRE(c);
+  const epichead::head::HeadControllerOptions defaults;
+  CHECK(c->controller.stabilise_gain_per_s == defaults.stabilise_gain_per_s);
+  CHECK(c->controller.fixate_gain_per_s == defaults.fixate_gain_per_s);
+  CHECK(c->controller.backlash.pan_rad == 0);
+}
+
+TEST_CASE("run config: gains and backlash are read into the controller's options") {
+  TempDir dir;
+  const auto c = read_run_config(write_config(
+      dir, R"("controller": { "stabilise_gain_per_s": 42, "fixate_gain_per_s": 2.5, "rate_lead_s": 0.006,
+                               "hold_max_rate_radps": 1.25 },
+             "head": { "pan_backlash_rad": 0.004 })"));
+  REQUIRE(c);
+  CHECK(c->controller.stabilise_gain_per_s == 42);
+  CHECK(c->controller.fixate_gain_per_s == 2.5);
+  CHECK(c->controller.rate_lead_s == 0.006);
+  CHECK(c->controller.hold_max_rate_radps == 1.25);
+  CHECK(c->controller.backlash.pan_rad == 0.004);
+  CHECK(c->controller.target_rate_filter_s == epichead::head::HeadControllerOptions{}.target_rate_filter_s);
+}
+
+TEST_CASE("run config: an unknown gain, a gain out of range or of the wrong type is an error naming it") {
+  TempDir dir;
+  const auto unknown = read_run_config(write_config(dir, R"("controller": { "stabilize_gain_per_s": 42 })"));
+  REQUIRE_FALSE(unknown);
+  CHECK(unknown.error().find("controller.stabilize_gain_per_s") != std::string::npos);
+  const auto negative = read_run_config(write_config(dir, R"("controller": { "fixate_gain_per_s": -1 })"));
+  REQUIRE_FALSE(negative);
+  CHECK(negative.error().find("controller.fixate_gain_per_s") != std::string::npos);
+  const auto text = read_run_config(write_config(dir, R"("controller": { "hold_gain_per_s": "10" })"));
+  REQUIRE_FALSE(text);
+  CHECK(text.error().find("controller.hold_gain_per_s") != std::string::npos);
+  const auto not_object = read_run_config(write_config(dir, R"("controller": 3)"));
+  REQUIRE_FALSE(not_object);
+  CHECK(not_object.error().find("controller must be an object") != std::string::npos);
+}
+
+TEST_CASE("run --help lists the configuration keys and the controller's gains") {
+  TempDir scratch;
+  const auto r = epichead::testing::run_epichead(scratch, "run --help");
+  CHECK(r.exit_code == 0);
+  for (const char* key : {"camera_calibration", "init_pose", "pan_backlash_rad", "stabilise_gain_per_s", "fixate_gain_per_s",
+                          "rate_lead_s", "hold_max_rate_radps"})
+    CHECK(r.out.find(key) != std::string::npos);
+}

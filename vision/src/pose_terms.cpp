@@ -1,0 +1,69 @@
+#include "pose_terms.h"
+
+#include <Eigen/LU>
+
+#include "epichead/geometry/so3.h"
+
+namespace epichead::vision::detail {
+
+// A line's residuals depend on the pose only through its image line l, so r_k = f(l, x_k) and
+// J_k = (dr_k/dl)^T dl/dxi with one 3x6 dl/dxi per line: the edgels accumulate the 3x3
+// sum w (dr/dl)(dr/dl)^T and the 3-vector sum w r dr/dl, and the 6x6 is formed once per line
+// (dl^T M dl) instead of once per edgel. The same sums as per-edgel rows, grouped differently
+// (round-off only).
+void add_line_block(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
+                    const Tukey& k, NormalEquations& ne) {
+  const Eigen::Vector3d& l = img.l;
+  const double s = img.s;
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (std::size_t q = 0; q < obs.edgels_px.size(); ++q) {
+    const double r = line_residual(obs, img, xns[q], focal);
+    const double w = k.weight(r);  // no skip at w = 0: a non-finite row must still reach H
+    ne.cost += k.rho(r);
+    const Eigen::Vector3d x(xns[q].x(), xns[q].y(), 1);
+    const double ldx = l.dot(x);
+    // dr/dl, the same expression (and values) as the per-edgel Jacobian had.
+    const Eigen::Vector3d dr_dl = (x / s - ldx / (s * s * s) * Eigen::Vector3d(l.x(), l.y(), 0)) * focal / obs.sigma_px;
+    M.noalias() += (w * dr_dl) * dr_dl.transpose();
+    v += (w * r) * dr_dl;
+    ne.wr2 += w * r * r;
+    ne.wsum += w;
+  }
+  // dl/dxi of l = A x B under a left perturbation of the pose: dA = [I | -[A]x] dxi (same for
+  // B), so dl = [A - B]x dt - [l]x dphi (using [B]x[A]x - [A]x[B]x = [B x A]x).
+  Eigen::Matrix<double, 3, 6> dl;
+  dl.leftCols<3>() = geometry::skew(img.A - img.B);
+  dl.rightCols<3>() = -geometry::skew(l);
+  ne.H.noalias() += dl.transpose() * M * dl;
+  ne.g.noalias() += dl.transpose() * v;
+}
+
+Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::Isometry3d& cam_T_obj) {
+  const Eigen::Vector3d c = cam_T_obj * circle.centre_obj;
+  const Eigen::Vector3d n = cam_T_obj.linear() * circle.normal_obj.normalized();
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  Eigen::Matrix3d Q;
+  Q << circle.radius_m * u, circle.radius_m * v, c;
+  const Eigen::Matrix3d Qi = Q.inverse();
+  return Qi.transpose() * Eigen::Vector3d(1, 1, -1).asDiagonal() * Qi;
+}
+
+void PoseTerms::normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne) const {
+  ne = NormalEquations{};
+  for (std::size_t i = 0; i < problem_.lines.size(); ++i) {
+    const LineObservation& obs = problem_.lines[i];
+    if (obs.edgels_px.size() < 2 || skip(static_cast<int>(i), Rejected::Skip)) continue;
+    add_line_block(obs, line_image(obs, cam_T_obj), line_edgels(i), focal_, k, ne);
+  }
+  rows(cam_T_obj, Rejected::Skip, true, [&](double r, const RowJ& J, int) { ne.add_row(r, J, k); });
+}
+
+bool PoseTerms::all_in_front(const Eigen::Isometry3d& cam_T_obj) const {
+  for (const auto& obs : problem_.lines)
+    if (obs.edgels_px.size() >= 2 && ((cam_T_obj * obs.a_obj).z() <= 0 || (cam_T_obj * obs.b_obj).z() <= 0)) return false;
+  for (const auto& obs : problem_.points) if ((cam_T_obj * obs.p_obj).z() <= 0) return false;
+  return true;
+}
+
+}  // namespace epichead::vision::detail
