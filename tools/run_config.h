@@ -52,8 +52,9 @@ head::HeadControllerOptions controller_options(const RunConfig& config, head::He
 // The keys with the defaults of `controller`, as `epichead run --help` prints them.
 std::string run_config_help(const head::HeadControllerOptions& controller);
 
-// Reads the JSON file at `path`; the three file paths are resolved against its folder. Errors
-// are one line starting with the path.
+// Reads the JSON file at `path`; the three file paths are resolved against its folder. Numbers
+// are checked: camera width and height whole numbers 1..65535, fps 0..1e6, backlashes 0..1 rad,
+// the controller's gains within their ranges. Errors are one line starting with the path.
 std::expected<RunConfig, std::string> read_run_config(const std::string& path);
 
 }  // namespace epichead::tools
