@@ -1,6 +1,6 @@
 // The `epichead run --config` reader: the controller's gains come from the file, a gain the
 // controller does not have or out of its range is an error naming it, and --help lists them.
-#include <catch2/catch_test_macros.hpp>
+#include <catch2/catch.hpp>
 
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
