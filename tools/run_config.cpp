@@ -37,7 +37,7 @@ using Options = head::HeadControllerOptions;
 struct GainField {
   const char* key;
   std::optional<double> Gains::*given;
-  double head::HeadControllerOptions::*target;
+  double Options::*target;
   double lo, hi;
 };
 
@@ -69,6 +69,7 @@ head::HeadControllerOptions controller_options(const RunConfig& config, head::He
 }
 
 std::string run_config_help(const head::HeadControllerOptions& controller) {
+  const RunConfig d;  // the defaults of every key but the gains, from the option types
   std::string gains;
   for (const GainField& f : kGains) {
     char item[96];
@@ -76,16 +77,20 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
                   controller.*f.target);
     gains += item;
   }
+  char devices[256];
+  std::snprintf(devices, sizeof devices,
+                "    \"camera\": { \"device\": \"%s\", \"width\": %d, \"height\": %d, \"fps\": %g },\n"
+                "    \"can\": { \"interface\": \"%s\" },\n"
+                "    \"head\": { \"pan_backlash_rad\": %g, \"tilt_backlash_rad\": %g },\n",
+                d.camera.device.c_str(), d.camera.width, d.camera.height, d.camera.frame_rate_hz, d.can.interface.c_str(),
+                d.backlash.pan_rad, d.backlash.tilt_rad);
   return "The configuration (JSON; relative paths from its folder; every key but the three files has\n"
          "the default shown):\n"
          "  { \"model\": \"teabox/model.cao\", \"camera_calibration\": \"teabox/camera.yaml\",\n"
-         "    \"init_pose\": \"teabox/init.csv\",\n"
-         "    \"camera\": { \"device\": \"/dev/video0\", \"width\": 640, \"height\": 480, \"fps\": 0 },\n"
-         "    \"can\": { \"interface\": \"can0\" },\n"
-         "    \"head\": { \"pan_backlash_rad\": 0, \"tilt_backlash_rad\": 0 },\n"
-         "    \"controller\": { " + gains + " },\n"
-         "    \"mode\": \"fixate\",\n"
-         "    \"out\": \"run-out\" }\n"
+         "    \"init_pose\": \"teabox/init.csv\",\n" +
+         std::string(devices) + "    \"controller\": { " + gains + " },\n    \"mode\": \"" + d.mode +
+         "\",\n    \"out\": \"" + d.out +
+         "\" }\n"
          "fps 0: the driver's current rate. Backlash: the gear's dead band per joint (0: none). The\n"
          "controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.\n";
 }

@@ -1,32 +1,14 @@
 #pragma once
-// The configuration of `epichead run --config FILE`: the onboard loop on real devices. JSON:
-//
-//   { "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
-//     "init_pose": "teabox/init.csv",              // where tracking starts (cMo)
-//     "camera": { "device": "/dev/video0", "width": 640, "height": 480,
-//                 "fps": 0 },                      // 0: the driver's current frame rate
-//     "can": { "interface": "can0" },
-//     "head": { "pan_backlash_rad": 0,             // the gear's dead band per joint, as measured
-//               "tilt_backlash_rad": 0 },          // (docs/head.md); 0: no compensation
-//     "controller": { "stabilise_gain_per_s": 60,   // optical-axis angle error -> camera rate
-//                     "fixate_gain_per_s": 5,       // target angle error -> camera rate
-//                     "fixate_max_rate_radps": 1.5, // how fast fixation itself may turn the camera
-//                     "target_rate_filter_s": 0.15, // low-pass of the target direction's rate
-//                     "target_rate_max_radps": 1.0, // bound on that rate's feed-forward
-//                     "hold_gain_per_s": 10,        // joint angle error -> joint rate (hold, park)
-//                     "hold_max_rate_radps": 2.0,
-//                     "rate_lead_s": 0,             // body-rate prediction; 0: off (docs/head.md)
-//                     "rate_lead_filter_s": 0.004 },
-//     "mode": "fixate",                            // fixate | stabilise | hold
-//     "out": "run-out" }                           // bus.log and diagnostics.jsonl go here
-//
-// Relative paths are taken from the configuration file's folder. Every key but the three files
-// has the default shown. A library of its own (not only in cmd_run.cpp) so the fuzz target
+// The configuration of `epichead run --config FILE`: the onboard loop on real devices, as JSON:
+// the model, calibration and start pose files, the camera device, the CAN interface, the joints'
+// backlash, the controller's gains, the mode and the output folder. The keys with their defaults
+// are what run_config_help() prints (`epichead run --help`), made from the option types
+// themselves so the text cannot drift from the code. Relative paths are taken from the
+// configuration file's folder. A library of its own (not only in cmd_run.cpp) so the fuzz target
 // tests/fuzz/fuzz_run_config.cpp links the same reader the program uses.
 #include <expected>
-#include <string>
-
 #include <optional>
+#include <string>
 
 #include "epichead/head/head_controller.h"
 #include "epichead/hw/socketcan_bus.h"
