@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "command.h"
-#include "epichead/vision/overlay.h"
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/overlay.h"
+#include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/visibility.h"
 
 namespace epichead::tools {

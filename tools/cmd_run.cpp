@@ -20,7 +20,7 @@
 #include "epichead/hw/v4l2_camera.h"
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 namespace epichead::tools {
 namespace {

@@ -18,9 +18,9 @@
 
 #include "command.h"
 #include "line_selection_score.h"
-#include "epichead/vision/score.h"
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/score.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 namespace epichead::tools {
 namespace {
@@ -91,6 +91,39 @@ void print_human(const std::string& seq_dir, const ScoreSummary& s, int ignored)
   row("reprojection_px", s.reprojection_px);
 }
 
+// --corners FRAME:FILE...: per frame, the distance of the projected model points from the
+// hand-read corners at that frame's estimate (present: false when lost or absent).
+std::expected<nlohmann::json, std::string> score_corners(const std::vector<std::string>& specs,
+                                                         const std::vector<vision::StampedPose>& estimates,
+                                                         const vision::Camera& camera) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const std::string& spec : specs) {
+    const auto colon = spec.find(':');
+    int frame = -1;
+    try {
+      std::size_t used = 0;
+      frame = colon == std::string::npos ? -1 : std::stoi(spec.substr(0, colon), &used);
+      if (used != colon) frame = -1;
+    } catch (const std::exception&) {
+      frame = -1;
+    }
+    if (frame < 0) return std::unexpected("--corners '" + spec + "': expected FRAME:FILE");
+    auto points = vision::read_corners(spec.substr(colon + 1));
+    if (!points) return std::unexpected(points.error());
+    const vision::StampedPose* at = nullptr;
+    for (const auto& e : estimates)
+      if (e.frame == frame && e.status != "lost") at = &e;
+    nlohmann::json c{{"frame", frame}, {"file", spec.substr(colon + 1)}, {"present", at != nullptr}};
+    if (at) {
+      const vision::CornerError err = vision::corner_error(*points, at->cam_T_obj, camera);
+      c["rms_px"] = err.rms_px;
+      c["max_px"] = err.max_px;
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
 const CommandRegistration registration{
     "score", "Score a tracker's poses against a sequence's ground truth (5 cm / 5 deg success, errors, losses)",
     [](CLI::App& app) {
@@ -132,31 +165,8 @@ const CommandRegistration registration{
         if (!estimates) return fail("score", estimates.error());
 
         // Hand-read corners of single frames.
-        nlohmann::json corner_json = nlohmann::json::array();
-        for (const std::string& spec : *corners) {
-          const auto colon = spec.find(':');
-          int frame = -1;
-          try {
-            std::size_t used = 0;
-            frame = colon == std::string::npos ? -1 : std::stoi(spec.substr(0, colon), &used);
-            if (used != colon) frame = -1;
-          } catch (const std::exception&) {
-            frame = -1;
-          }
-          if (frame < 0) return fail("score", "--corners '" + spec + "': expected FRAME:FILE");
-          auto points = vision::read_corners(spec.substr(colon + 1));
-          if (!points) return fail("score", points.error());
-          const vision::StampedPose* at = nullptr;
-          for (const auto& e : *estimates)
-            if (e.frame == frame && e.status != "lost") at = &e;
-          nlohmann::json c{{"frame", frame}, {"file", spec.substr(colon + 1)}, {"present", at != nullptr}};
-          if (at) {
-            const vision::CornerError err = vision::corner_error(*points, at->cam_T_obj, seq->camera());
-            c["rms_px"] = err.rms_px;
-            c["max_px"] = err.max_px;
-          }
-          corner_json.push_back(c);
-        }
+        auto corner_json = score_corners(*corners, *estimates, seq->camera());
+        if (!corner_json) return fail("score", corner_json.error());
         std::vector<vision::StampedPose> truth_poses;
         if (!reference->empty()) {
           auto ref = vision::read_pose_csv(*reference);
@@ -169,9 +179,9 @@ const CommandRegistration registration{
         }
         if (truth_poses.empty()) {  // corners only
           if (*json) {
-            std::cout << nlohmann::json{{"corners", corner_json}}.dump() << std::endl;
+            std::cout << nlohmann::json{{"corners", *corner_json}}.dump() << std::endl;
           } else {
-            for (const auto& c : corner_json)
+            for (const auto& c : *corner_json)
               std::printf("corners frame %d: %s\n", c["frame"].get<int>(),
                           c["present"].get<bool>() ? (std::to_string(c["rms_px"].get<double>()) + " px rms, " +
                                                       std::to_string(c["max_px"].get<double>()) + " px max").c_str()
@@ -209,12 +219,12 @@ const CommandRegistration registration{
                                  {"translation_mm", stats_json(summary.translation_mm)},
                                  {"reprojection_px", stats_json(summary.reprojection_px)},
                                  {"against", reference->empty() ? "gt.csv" : *reference},
-                                 {"corners", corner_json},
+                                 {"corners", *corner_json},
                                  {"line_selection", line_json}};
           std::cout << j.dump() << std::endl;
         } else {
           print_human(*seq_dir, summary, ignored);
-          for (const auto& c : corner_json)
+          for (const auto& c : *corner_json)
             if (c["present"].get<bool>())
               std::printf("corners frame %d   %.2f px rms, %.2f px max\n", c["frame"].get<int>(), c["rms_px"].get<double>(),
                           c["max_px"].get<double>());

@@ -23,7 +23,7 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
-#include "epichead/vision/overlay.h"
+#include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/visibility.h"
 
 namespace epichead::tools {
@@ -52,6 +52,24 @@ struct RunMeasures {
   plot::Series pan{"pan (deg)", {}, {}}, tilt{"tilt (deg)", {}, {}};
   plot::Series centring{"target from centre (px)", {}, {}};
 };
+
+// One frame's overlay PNG: the model at the tracker's pose, captioned. Returns whether it was written.
+bool write_overlay(const head::TrackedFrame& f, const vision::CadModel& model, const vision::Camera& cam,
+                   const std::string& out) {
+  const hw::CameraFrame& img = *f.image;
+  cv::Mat bgr(img.height, img.width, CV_8UC3, const_cast<std::uint8_t*>(img.data), static_cast<std::size_t>(img.stride_bytes));
+  cv::Mat canvas = bgr.clone();
+  const vision::VisibleModel vis = vision::compute_visibility(model, cam, f.report->cam_T_obj);
+  vision::draw_visible_model(canvas, vis);
+  char caption[128];
+  std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.report->status),
+                f.report->inliers, f.report->visible);
+  cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3, cv::LINE_AA);  // legible on light scenes
+  cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
+  char name[64];
+  std::snprintf(name, sizeof name, "overlay_%06llu.png", static_cast<unsigned long long>(f.index));
+  return cv::imwrite((fs::path(out) / name).string(), canvas);
+}
 
 std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& scenario, const SimRunArgs& a,
                                                           head::ControlMode mode, bool render, const std::string& out,
@@ -157,19 +175,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
     }
     ++m.frames;
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
-    const hw::CameraFrame& img = *f.image;
-    cv::Mat bgr(img.height, img.width, CV_8UC3, const_cast<std::uint8_t*>(img.data), static_cast<std::size_t>(img.stride_bytes));
-    cv::Mat canvas = bgr.clone();
-    const vision::VisibleModel vis = vision::compute_visibility(*model, cam, f.report->cam_T_obj);
-    vision::draw_visible_model(canvas, vis);
-    char caption[128];
-    std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.report->status),
-                  f.report->inliers, f.report->visible);
-    cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3, cv::LINE_AA);  // legible on light scenes
-    cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
-    char name[64];
-    std::snprintf(name, sizeof name, "overlay_%06llu.png", static_cast<unsigned long long>(f.index));
-    if (cv::imwrite((fs::path(out) / name).string(), canvas)) ++overlays;
+    overlays += write_overlay(f, *model, cam, out);
   };
   const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
   auto summary = (*loop)->run(std::min(until, w.horizon_s()), hook);

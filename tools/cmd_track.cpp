@@ -7,11 +7,15 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
+#include <expected>
 #include <filesystem>
 #include <vector>
 #include <fstream>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -22,9 +26,9 @@
 #include "printable.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
-#include "epichead/vision/overlay.h"
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/overlay.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "epichead/vision/window_image.h"
 
 namespace epichead::tools {
@@ -127,6 +131,121 @@ double percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
+// report.json's entry for one frame: status, stage times and feature counts.
+nlohmann::json frame_json(const FrameEntry& entry, const FrameReport& report) {
+  return {{"frame", entry.frame},
+                     {"t_s", entry.t_s},
+                     {"status", to_string(report.status)},
+                     {"reasons", to_string(report.reasons)},
+                     {"ms", {{"visibility", report.times.visibility_ms},
+                             {"epic", report.times.epic_ms},
+                             {"validation", report.times.validation_ms},
+                             {"pose", report.times.pose_ms},
+                             {"total", report.times.total_ms}}},
+                     {"lines", {{"visible", report.visible},
+                                {"found", report.found},
+                                {"kept", report.inliers},
+                                {"rejected", report.rejected},
+                                {"recovered", report.recovered},
+                                {"changed_by_validation", report.validated_changed}}},
+                     {"ellipses", {{"visible", report.ellipses_visible},
+                                   {"found", report.ellipses_found},
+                                   {"weak", report.ellipses_weak}}},
+                     {"junctions", report.junctions},
+                     {"combinations", report.combinations},
+                     {"scale_px", report.scale_px},
+                     {"pose_iterations", report.pose_iterations}};
+}
+
+// The PNG overlays (every Nth frame, optionally a zoomed region) and the overlay video of a run.
+class OverlayOutput {
+ public:
+  OverlayOutput(const TrackArgs& args, const Sequence& seq)
+      : args_(args), seq_(seq), video_path_((std::filesystem::path(args.out) / "overlay.mp4").string()) {}
+
+  // Draws the frame's overlay; writes it as a PNG when `png`, and to the video when asked for.
+  std::expected<void, std::string> write(const cv::Mat& frame, const ModelTracker& tracker, const FrameReport& report,
+                                         const VisibleModel& at_estimate, int frame_number, bool png) {
+    cv::Mat canvas;
+    if (frame.channels() == 1) cv::cvtColor(frame, canvas, cv::COLOR_GRAY2BGR);
+    else if (frame.channels() == 4) cv::cvtColor(frame, canvas, cv::COLOR_BGRA2BGR);
+    else canvas = frame.clone();
+    draw_frame(canvas, tracker, report, at_estimate, frame_number, args_.mode);
+    if (png)
+      if (auto ok = write_png(canvas, frame_number); !ok) return ok;
+    if (args_.video) write_video(canvas);
+    return {};
+  }
+  void close() { video_.release(); }
+  int pngs() const { return pngs_; }
+  const std::string& video_path() const { return video_path_; }
+  const std::string& video_note() const { return video_note_; }  // why there is no video, if there is none
+
+ private:
+  std::expected<void, std::string> write_png(const cv::Mat& canvas, int frame_number) {
+    char name[64];
+    std::snprintf(name, sizeof name, "overlay_%06d.png", frame_number);
+    const std::string path = (std::filesystem::path(args_.out) / name).string();
+    cv::Mat png_image = canvas;
+    if (!args_.zoom.empty()) {
+      // A close-up (the paper's Figs. 18/19 show the stiffeners this way): the region twice
+      // as large, pixels kept sharp, captioned with the frame and mode.
+      const cv::Rect region = cv::Rect(args_.zoom[0], args_.zoom[1], args_.zoom[2], args_.zoom[3]) & cv::Rect(0, 0, canvas.cols, canvas.rows);
+      if (region.area() == 0)
+        return std::unexpected("--zoom lies outside the " + std::to_string(canvas.cols) + "x" + std::to_string(canvas.rows) + " image");
+      cv::resize(canvas(region), png_image, {}, 2, 2, cv::INTER_NEAREST);
+      const std::string caption = "frame " + std::to_string(frame_number) + "  " + args_.mode;
+      cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 0, 0}, 3, cv::LINE_AA);
+      cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {255, 255, 255}, 1, cv::LINE_AA);
+    }
+    try {
+      if (!cv::imwrite(path, png_image)) return std::unexpected("cannot write " + path);
+    } catch (const cv::Exception& e) {
+      return std::unexpected("cannot write " + path + ": " + e.what());
+    }
+    ++pngs_;
+    return {};
+  }
+
+  void write_video(const cv::Mat& canvas) {
+    if (!video_.isOpened() && video_note_.empty()) {
+      const auto& fr = seq_.frames();
+      const double span_s = fr.size() > 1 ? fr.back().t_s - fr.front().t_s : 0.0;
+      const double fps = span_s > 0 ? static_cast<double>(fr.size() - 1) / span_s : 30.0;
+      video_.open(video_path_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, canvas.size());
+      if (!video_.isOpened()) video_note_ = "OpenCV could not open an MP4 writer for " + video_path_;
+    }
+    if (video_.isOpened()) video_.write(canvas);
+  }
+
+  const TrackArgs& args_;
+  const Sequence& seq_;
+  std::string video_path_, video_note_;
+  cv::VideoWriter video_;
+  int pngs_ = 0;
+};
+
+// --imu-time-offset-s: "auto" (nullopt: estimated) or seconds within +-10.
+std::expected<std::optional<double>, std::string> imu_time_offset(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || std::abs(v) > 10)
+    return std::unexpected("--imu-time-offset-s must be 'auto' or seconds within +-10, got '" + text + "'");
+  return v;
+}
+
+ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
+  ModelTrackerOptions options;
+  options.mode = mode;
+  options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
+  options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
+  options.lines.epic.ransac.seed = args.ransac_seed;
+  options.free_turn_of_revolution = args.free_turn == "auto";
+  options.settle = args.settle;
+  return options;
+}
+
 int run_track(const TrackArgs& args) {
   const char* cmd = "track";
   static const std::map<std::string, TrackMode> modes{
@@ -137,15 +256,9 @@ int run_track(const TrackArgs& args) {
   if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
   auto seq = Sequence::open(args.seq);
   if (!seq) return fail(cmd, seq.error());
-  std::optional<double> offset;
-  if (args.imu_time_offset != "auto") {
-    char* end = nullptr;
-    const double v = std::strtod(args.imu_time_offset.c_str(), &end);
-    if (end == args.imu_time_offset.c_str() || *end != '\0' || !std::isfinite(v) || std::abs(v) > 10)
-      return fail(cmd, "--imu-time-offset-s must be 'auto' or seconds within +-10, got '" + args.imu_time_offset + "'");
-    offset = v;
-  }
-  auto predictor = make_track_predictor(*seq, args.imu == "on", offset);
+  const auto offset = imu_time_offset(args.imu_time_offset);
+  if (!offset) return fail(cmd, offset.error());
+  auto predictor = make_track_predictor(*seq, args.imu == "on", *offset);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -153,21 +266,13 @@ int run_track(const TrackArgs& args) {
   fs::create_directories(args.out, ec);
   if (ec) return fail(cmd, "cannot create " + args.out + ": " + ec.message());
 
-  ModelTrackerOptions options;
-  options.mode = mode->second;
-  options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
-  options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
-  options.lines.epic.ransac.seed = args.ransac_seed;
-  options.free_turn_of_revolution = args.free_turn == "auto";
-  options.settle = args.settle;
+  const ModelTrackerOptions options = tracker_options(args, mode->second);
   ModelTracker tracker(seq->model(), seq->camera(), options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
   WindowImage image;
   FrameReport report;
-  cv::VideoWriter video;
-  const std::string video_path = (fs::path(args.out) / "overlay.mp4").string();
-  std::string video_note;
+  OverlayOutput overlays(args, *seq);
 
   // Per frame and visible model edge, the candidate the tracker selected: what `epichead score
   // --lines` checks against the ground truth (did the tracker pick the right edge?).
@@ -180,7 +285,7 @@ int run_track(const TrackArgs& args) {
   int fused_frames = 0, fallback_frames = 0;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
-  int tracked = 0, degraded = 0, lost = 0, overlays = 0;
+  int tracked = 0, degraded = 0, lost = 0;
   std::size_t n = seq->frame_count();
   if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
   for (std::size_t i = 0; i < n; ++i) {
@@ -208,74 +313,17 @@ int run_track(const TrackArgs& args) {
       }
     poses.push_back({entry.frame, entry.t_s, estimate, to_string(report.status)});
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
-    per_frame.push_back({{"frame", entry.frame},
-                         {"t_s", entry.t_s},
-                         {"status", to_string(report.status)},
-                         {"reasons", to_string(report.reasons)},
-                         {"ms", {{"visibility", report.times.visibility_ms},
-                                 {"epic", report.times.epic_ms},
-                                 {"validation", report.times.validation_ms},
-                                 {"pose", report.times.pose_ms},
-                                 {"total", report.times.total_ms}}},
-                         {"lines", {{"visible", report.visible},
-                                    {"found", report.found},
-                                    {"kept", report.inliers},
-                                    {"rejected", report.rejected},
-                                    {"recovered", report.recovered},
-                                    {"changed_by_validation", report.validated_changed}}},
-                         {"ellipses", {{"visible", report.ellipses_visible},
-                                       {"found", report.ellipses_found},
-                                       {"weak", report.ellipses_weak}}},
-                         {"junctions", report.junctions},
-                         {"combinations", report.combinations},
-                         {"scale_px", report.scale_px},
-                         {"pose_iterations", report.pose_iterations}});
+    per_frame.push_back(frame_json(entry, report));
 
     write_selected_lines(lines_csv, tracker, report, entry.frame);
 
     const bool png = args.every > 0 && (i % static_cast<std::size_t>(args.every) == 0 || i + 1 == n);
     if (png || args.video) {
-      cv::Mat canvas;
-      if (frame->channels() == 1) cv::cvtColor(*frame, canvas, cv::COLOR_GRAY2BGR);
-      else if (frame->channels() == 4) cv::cvtColor(*frame, canvas, cv::COLOR_BGRA2BGR);
-      else canvas = frame->clone();
       overlay_visibility.compute(report.cam_T_obj, at_estimate);
-      draw_frame(canvas, tracker, report, at_estimate, entry.frame, args.mode);
-      if (png) {
-        char name[64];
-        std::snprintf(name, sizeof name, "overlay_%06d.png", entry.frame);
-        const std::string path = (fs::path(args.out) / name).string();
-        cv::Mat png_image = canvas;
-        if (!args.zoom.empty()) {
-          // A close-up (the paper's Figs. 18/19 show the stiffeners this way): the region twice
-          // as large, pixels kept sharp, captioned with the frame and mode.
-          const cv::Rect region = cv::Rect(args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]) & cv::Rect(0, 0, canvas.cols, canvas.rows);
-          if (region.area() == 0) return fail(cmd, "--zoom lies outside the " + std::to_string(canvas.cols) + "x" + std::to_string(canvas.rows) + " image");
-          cv::resize(canvas(region), png_image, {}, 2, 2, cv::INTER_NEAREST);
-          const std::string caption = "frame " + std::to_string(entry.frame) + "  " + args.mode;
-          cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 0, 0}, 3, cv::LINE_AA);
-          cv::putText(png_image, caption, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {255, 255, 255}, 1, cv::LINE_AA);
-        }
-        try {
-          if (!cv::imwrite(path, png_image)) return fail(cmd, "cannot write " + path);
-        } catch (const cv::Exception& e) {
-          return fail(cmd, "cannot write " + path + ": " + e.what());
-        }
-        ++overlays;
-      }
-      if (args.video) {
-        if (!video.isOpened() && video_note.empty()) {
-          const auto& fr = seq->frames();
-          const double span_s = fr.size() > 1 ? fr.back().t_s - fr.front().t_s : 0.0;
-          const double fps = span_s > 0 ? static_cast<double>(fr.size() - 1) / span_s : 30.0;
-          video.open(video_path, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, canvas.size());
-          if (!video.isOpened()) video_note = "OpenCV could not open an MP4 writer for " + video_path;
-        }
-        if (video.isOpened()) video.write(canvas);
-      }
+      if (auto ok = overlays.write(*frame, tracker, report, at_estimate, entry.frame, png); !ok) return fail(cmd, ok.error());
     }
   }
-  video.release();
+  overlays.close();
 
   const std::string poses_path = (fs::path(args.out) / "poses.csv").string();
   if (auto ok = write_pose_csv(poses_path, poses); !ok) return fail(cmd, ok.error());
@@ -301,7 +349,7 @@ int run_track(const TrackArgs& args) {
     j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
                            {"direction_obj", {a.direction_obj.x(), a.direction_obj.y(), a.direction_obj.z()}}};
   }  // frames whose poses.csv row is the filter's estimate
-  if (!video_note.empty()) j["video_note"] = video_note;
+  if (!overlays.video_note().empty()) j["video_note"] = overlays.video_note();
   j["per_frame"] = std::move(per_frame);
   const std::string report_path = (fs::path(args.out) / "report.json").string();
   std::ofstream rep(report_path);
@@ -310,9 +358,15 @@ int run_track(const TrackArgs& args) {
   std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost; tracking %.3f ms median, %.3f ms p99\n", n,
               args.mode.c_str(), args.imu.c_str(), tracked, degraded, lost, percentile(track_ms, 0.5),
               percentile(track_ms, 0.99));
-  std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays,
-              args.video && video_note.empty() ? (" and " + video_path).c_str() : "");
-  if (!video_note.empty()) std::fprintf(stderr, "track: %s\n", printable(video_note).c_str());
+  std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
+              args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");
+  if (!overlays.video_note().empty()) std::fprintf(stderr, "track: %s\n", printable(overlays.video_note()).c_str());
+  // IMU samples the predictor could not use are counted in report.json; say so where it is seen.
+  const nlohmann::json& pd = j["predictor"];
+  if (pd.contains("imu_rejected") && pd["imu_rejected"].get<std::uint64_t>() > 0)
+    std::fprintf(stderr, "track: %llu IMU samples dropped (%llu saturated or beyond any sensor's range); report.json: predictor\n",
+                 static_cast<unsigned long long>(pd["imu_rejected"].get<std::uint64_t>()),
+                 static_cast<unsigned long long>(pd.value("imu_saturated", std::uint64_t{0})));
   return 0;
 }
 

@@ -19,7 +19,7 @@
 #include "command.h"
 #include "epichead/vision/ellipse_tracker.h"
 #include "epichead/vision/line_tracker.h"
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/visibility.h"
 #include "epichead/vision/window_image.h"
 
@@ -96,6 +96,24 @@ void draw_ellipses(cv::Mat& canvas, const EllipseTracker& tracker) {
   }
 }
 
+// One row of ellipses.csv for a visible circle.
+std::string ellipse_row(int frame_number, const EllipseFeature& f) {
+  char buf[256];
+  int hit = 0;
+  for (unsigned char h : f.row_hit) hit += h;
+  if (f.found) {
+    const Ellipse& e = f.ellipse;
+    std::snprintf(buf, sizeof buf, "%d,%d,1,%zu,%.3f,%.3f,%.3f,%.3f,%.2f,%.1f,%.1f,%d,%d,%d,%zu,%zu\n", frame_number,
+                  f.circle, f.candidates.size(), e.centre_px.x(), e.centre_px.y(), e.semi_major_px, e.semi_minor_px,
+                  e.angle_rad * 180 / M_PI, f.arc.begin_rad * 180 / M_PI, std::min(f.arc.span_rad, 2 * M_PI) * 180 / M_PI,
+                  f.weak ? 1 : 0, f.inlier_count(), hit, f.lines.size(), f.result.good.size());
+  } else {
+    std::snprintf(buf, sizeof buf, "%d,%d,0,%zu,,,,,,,,0,0,%d,%zu,%zu\n", frame_number, f.circle, f.candidates.size(), hit,
+                  f.lines.size(), f.result.good.size());
+  }
+  return buf;
+}
+
 int run_track_lines(const std::string& seq_dir, const std::string& out_dir, const std::string& mode_name, int every,
                     double crease_deg, const std::string& rim_side_name) {
   const char* cmd = "track-lines";
@@ -170,20 +188,8 @@ int run_track_lines(const std::string& seq_dir, const std::string& out_dir, cons
       if (!f.visible) continue;
       ++ellipses_placed;
       ellipses_found += f.found;
-      int hit = 0;
-      for (unsigned char h : f.row_hit) hit += h;
-      if (f.found) {
-        ellipses_on_arc += !f.arc.full();
-        const Ellipse& e = f.ellipse;
-        std::snprintf(buf, sizeof buf, "%d,%d,1,%zu,%.3f,%.3f,%.3f,%.3f,%.2f,%.1f,%.1f,%d,%d,%d,%zu,%zu\n", frame_number,
-                      f.circle, f.candidates.size(), e.centre_px.x(), e.centre_px.y(), e.semi_major_px, e.semi_minor_px,
-                      e.angle_rad * 180 / M_PI, f.arc.begin_rad * 180 / M_PI, std::min(f.arc.span_rad, 2 * M_PI) * 180 / M_PI,
-                      f.weak ? 1 : 0, f.inlier_count(), hit, f.lines.size(), f.result.good.size());
-      } else {
-        std::snprintf(buf, sizeof buf, "%d,%d,0,%zu,,,,,,,,0,0,%d,%zu,%zu\n", frame_number, f.circle, f.candidates.size(), hit,
-                      f.lines.size(), f.result.good.size());
-      }
-      ellipse_csv << buf;
+      ellipses_on_arc += f.found && !f.arc.full();
+      ellipse_csv << ellipse_row(frame_number, f);
     }
     if (every > 0 && (i % static_cast<std::size_t>(every) == 0 || i + 1 == n)) {
       cv::Mat canvas;

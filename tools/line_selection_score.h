@@ -14,8 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 namespace epichead::tools {
 

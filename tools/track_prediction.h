@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "epichead/vision/model_tracker.h"
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 
 namespace epichead::tools {
 

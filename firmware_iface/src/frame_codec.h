@@ -49,6 +49,26 @@ inline std::optional<WireError> check_shape(const CanFrame& f) {
   return std::nullopt;
 }
 
+// The payload word of a classic 8-byte data frame with exactly this id, or why the frame is not one.
+inline std::expected<std::uint64_t, WireError> payload_of(const CanFrame& f, std::uint32_t id) {
+  if (f.id != id) return std::unexpected(WireError{WireErrorKind::UnknownId, f.id, -1, {}, 0});
+  if (auto bad = check_shape(f)) return std::unexpected(*bad);
+  return load_word(f);
+}
+
+// The same for a message whose CAN id carries a node number (heartbeat, time sync): the id's
+// type and node, and the payload word.
+struct NodePayload {
+  MessageId id;
+  std::uint64_t word = 0;
+};
+inline std::expected<NodePayload, WireError> node_payload_of(const CanFrame& f, MessageType type) {
+  const auto id = classify_id(f.id);
+  if (!id || id->type != type) return std::unexpected(WireError{WireErrorKind::UnknownId, f.id, -1, {}, 0});
+  if (auto bad = check_shape(f)) return std::unexpected(*bad);
+  return NodePayload{*id, load_word(f)};
+}
+
 inline WireError out_of_range(std::uint32_t id, const SignalSpec& s, std::int64_t raw) {
   return WireError{WireErrorKind::OutOfRange, id, s.start_bit / 8, s.name, raw};
 }

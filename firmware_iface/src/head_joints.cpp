@@ -7,8 +7,6 @@
 namespace epichead::firmware_iface {
 
 using detail::at_limit;
-using detail::check_shape;
-using detail::load_word;
 using detail::Packer;
 using detail::raw_of;
 
@@ -32,9 +30,9 @@ std::expected<EncodedFrame, WireError> encode_joints(const M& m, std::uint32_t i
 
 template <typename M>
 std::expected<M, WireError> decode_joints(const CanFrame& frame, std::uint32_t id, MessageType type) {
-  if (frame.id != id) return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::payload_of(frame, id);
+  if (!payload) return std::unexpected(payload.error());
+  const std::uint64_t w = *payload;
   const auto specs = signal_table(type);
   const std::int64_t mode = raw_of(w, specs[kMode]);
   if (mode >= kHeadModeCount) return std::unexpected(detail::out_of_range(id, specs[kMode], mode));

@@ -5,8 +5,6 @@
 namespace epichead::firmware_iface {
 
 using detail::at_limit;
-using detail::check_shape;
-using detail::load_word;
 using detail::Packer;
 using detail::raw_of;
 
@@ -35,9 +33,9 @@ std::expected<EncodedFrame, WireError> encode(const HeadStatus& m) {
 }
 
 std::expected<HeadStatus, WireError> decode_head_status(const CanFrame& frame) {
-  if (frame.id != kIdHeadStatus) return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::payload_of(frame, kIdHeadStatus);
+  if (!payload) return std::unexpected(payload.error());
+  const std::uint64_t w = *payload;
   const auto specs = signal_table(MessageType::HeadStatus);
   const std::int64_t faults = raw_of(w, specs[kFaults]);
   if (faults & ~static_cast<std::int64_t>(kHeadFaultDefinedMask))

@@ -4,8 +4,6 @@
 
 namespace epichead::firmware_iface {
 
-using detail::check_shape;
-using detail::load_word;
 using detail::Packer;
 using detail::raw_of;
 
@@ -41,11 +39,10 @@ std::expected<EncodedFrame, WireError> encode(const Heartbeat& m) {
 }
 
 std::expected<Heartbeat, WireError> decode_heartbeat(const CanFrame& frame) {
-  const auto id = classify_id(frame.id);
-  if (!id || id->type != MessageType::Heartbeat)
-    return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::node_payload_of(frame, MessageType::Heartbeat);
+  if (!payload) return std::unexpected(payload.error());
+  const MessageId* id = &payload->id;
+  const std::uint64_t w = payload->word;
   const auto specs = signal_table(MessageType::Heartbeat);
   const std::int64_t state = raw_of(w, specs[kState]);
   if (state >= kNodeStateCount) return std::unexpected(detail::out_of_range(frame.id, specs[kState], state));

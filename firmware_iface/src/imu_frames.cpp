@@ -5,8 +5,6 @@
 namespace epichead::firmware_iface {
 
 using detail::at_limit;
-using detail::check_shape;
-using detail::load_word;
 using detail::Packer;
 using detail::raw_of;
 
@@ -23,9 +21,9 @@ std::expected<EncodedFrame, WireError> encode_vector(const ImuVectorFrame& m, st
 
 template <typename M>
 std::expected<M, WireError> decode_vector(const CanFrame& frame, std::uint32_t id, MessageType type) {
-  if (frame.id != id) return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::payload_of(frame, id);
+  if (!payload) return std::unexpected(payload.error());
+  const std::uint64_t w = *payload;
   const auto specs = signal_table(type);
   M m;
   for (int axis = 0; axis < 3; ++axis) {

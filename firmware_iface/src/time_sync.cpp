@@ -4,8 +4,6 @@
 
 namespace epichead::firmware_iface {
 
-using detail::check_shape;
-using detail::load_word;
 using detail::Packer;
 using detail::raw_of;
 
@@ -36,11 +34,9 @@ std::expected<EncodedFrame, WireError> encode(const TimeSyncReply& m) {
 }
 
 std::expected<TimeSyncRequest, WireError> decode_time_sync_request(const CanFrame& frame) {
-  const auto id = classify_id(frame.id);
-  if (!id || id->type != MessageType::TimeSyncRequest)
-    return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::node_payload_of(frame, MessageType::TimeSyncRequest);
+  if (!payload) return std::unexpected(payload.error());
+  const std::uint64_t w = payload->word;
   if (auto bad = check_reserved(frame, w)) return std::unexpected(*bad);
   const auto specs = signal_table(MessageType::TimeSyncRequest);
   return TimeSyncRequest{static_cast<std::uint8_t>(raw_of(w, specs[kSequence])),
@@ -48,11 +44,10 @@ std::expected<TimeSyncRequest, WireError> decode_time_sync_request(const CanFram
 }
 
 std::expected<TimeSyncReply, WireError> decode_time_sync_reply(const CanFrame& frame) {
-  const auto id = classify_id(frame.id);
-  if (!id || id->type != MessageType::TimeSyncReply)
-    return std::unexpected(WireError{WireErrorKind::UnknownId, frame.id, -1, {}, 0});
-  if (auto bad = check_shape(frame)) return std::unexpected(*bad);
-  const std::uint64_t w = load_word(frame);
+  const auto payload = detail::node_payload_of(frame, MessageType::TimeSyncReply);
+  if (!payload) return std::unexpected(payload.error());
+  const MessageId* id = &payload->id;
+  const std::uint64_t w = payload->word;
   if (auto bad = check_reserved(frame, w)) return std::unexpected(*bad);
   const auto specs = signal_table(MessageType::TimeSyncReply);
   return TimeSyncReply{id->node, static_cast<std::uint8_t>(raw_of(w, specs[kSequence])),

@@ -200,16 +200,18 @@ HeadController::Resolved HeadController::resolve() const {
   return {r, std::nullopt};
 }
 
+// The commands restart from the head's measured angles and rates (within the limits).
+void HeadController::command_from_head() {
+  pan_cmd_ = {std::clamp(head_.angles.pan_rad, options_.pan.min_rad, options_.pan.max_rad),
+              clamp_rate(head_.pan_rate_radps, options_.pan)};
+  tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
+               clamp_rate(head_.tilt_rate_radps, options_.tilt)};
+  pan_backlash_.reset(pan_cmd_.angle_rad);
+  tilt_backlash_.reset(tilt_cmd_.angle_rad);
+}
+
 void HeadController::enter(ControlMode mode, ModeReason reason, double t_s, ControlOutput& out) {
-  if (mode_ == ControlMode::Startup) {
-    // The first command starts where the head is.
-    pan_cmd_ = {std::clamp(head_.angles.pan_rad, options_.pan.min_rad, options_.pan.max_rad),
-                clamp_rate(head_.pan_rate_radps, options_.pan)};
-    tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
-                 clamp_rate(head_.tilt_rate_radps, options_.tilt)};
-    pan_backlash_.reset(pan_cmd_.angle_rad);
-    tilt_backlash_.reset(tilt_cmd_.angle_rad);
-  }
+  if (mode_ == ControlMode::Startup) command_from_head();  // the first command starts where the head is
   blend_t0_s_ = t_s;
   blend_from_ = {pan_cmd_.rate_radps, tilt_cmd_.rate_radps};
   switch (mode) {
@@ -319,26 +321,50 @@ Eigen::Vector2d HeadController::desired_rates(double t_s, ControlOutput& out) {
 ControlOutput HeadController::step(const ControlInput& in) {
   ControlOutput out;
   ++counters_.steps;
-  double dt = 0;
-  if (!finite(in.t_s) || (started_ && !(in.t_s > last_t_s_))) {
-    ++counters_.time_not_advancing;
-  } else {
-    if (started_) dt = std::min(in.t_s - last_t_s_, 5.0 / options_.rate_hz);
-    started_ = true;
-    last_t_s_ = in.t_s;
-  }
+  const double dt = advance_clock(in.t_s);
   const double t = last_t_s_;
   ingest(in);
-
   const bool request_changed = requested_ != last_requested_;
   last_requested_ = requested_;
+  const FaultChange change = supervise(t, in.bus == hw::CanBusState::BusOff, out);
+  const Resolved r = resolve();
+  if (r.mode != mode_) {
+    ModeReason reason = ModeReason::Recovered;
+    if (r.fallback) reason = *r.fallback;
+    else if (request_changed) reason = ModeReason::Requested;
+    else if (mode_ == ControlMode::Startup) reason = ModeReason::HeadStateArrived;
+    else if (has(change.cleared, Fault::TargetLost)) reason = ModeReason::TrackingRecovered;
+    enter(r.mode, reason, t, out);
+  }
+  bound_following_error();
+  const Eigen::Vector2d output_rates = shape_commands(t, dt, out);
+  encode_command(t, output_rates, out);
+  return out;
+}
+
+// The step's dt: 0 for a first, non-finite or non-advancing time (counted), else at most five
+// periods (a stalled caller must not make one step jump).
+double HeadController::advance_clock(double t_s) {
+  double dt = 0;
+  if (!finite(t_s) || (started_ && !(t_s > last_t_s_))) {
+    ++counters_.time_not_advancing;
+  } else {
+    if (started_) dt = std::min(t_s - last_t_s_, 5.0 / options_.rate_hz);
+    started_ = true;
+    last_t_s_ = t_s;
+  }
+  return dt;
+}
+
+// The watchdog over the inputs' ages: fault events, and what a raised or cleared fault resets.
+FaultChange HeadController::supervise(double t, bool bus_off, ControlOutput& out) {
   WatchdogInput w;
   w.t_s = t;
   w.have_gyro = have_gyro_;
   w.last_gyro_t_s = gyro_.t_s;
   w.have_head_state = have_head_;
   w.last_head_state_t_s = head_.t_s;
-  w.bus_off = in.bus == hw::CanBusState::BusOff;
+  w.bus_off = bus_off;
   w.fixating = requested_ == ControlMode::Fixate;
   w.have_target = have_target_;
   w.last_target_t_s = target_arrival_t_s_;
@@ -363,66 +389,60 @@ ControlOutput HeadController::step(const ControlInput& in) {
   // the command from where it is instead of from where it was told to be.
   if (mode_ != ControlMode::Startup && (has(change.cleared, Fault::BusOff) || has(change.cleared, Fault::HeadStateStale))) {
     joint_rates_.reset();
-    pan_cmd_ = {std::clamp(head_.angles.pan_rad, options_.pan.min_rad, options_.pan.max_rad),
-                clamp_rate(head_.pan_rate_radps, options_.pan)};
-    tilt_cmd_ = {std::clamp(head_.angles.tilt_rad, options_.tilt.min_rad, options_.tilt.max_rad),
-                 clamp_rate(head_.tilt_rate_radps, options_.tilt)};
-    pan_backlash_.reset(pan_cmd_.angle_rad);
-    tilt_backlash_.reset(tilt_cmd_.angle_rad);
+    command_from_head();
   }
+  return change;
+}
 
-  const Resolved r = resolve();
-  if (r.mode != mode_) {
-    ModeReason reason = ModeReason::Recovered;
-    if (r.fallback) reason = *r.fallback;
-    else if (request_changed) reason = ModeReason::Requested;
-    else if (mode_ == ControlMode::Startup) reason = ModeReason::HeadStateArrived;
-    else if (has(change.cleared, Fault::TargetLost)) reason = ModeReason::TrackingRecovered;
-    enter(r.mode, reason, t, out);
-  }
+// A joint that does not follow (stuck, blocked, slower than commanded) must not wind up the
+// commanded angle: the head would lunge when it frees.
+void HeadController::bound_following_error() {
+  if (mode_ == ControlMode::Startup || has(watchdog_.faults(), Fault::HeadStateStale)) return;
+  auto bound = [&](JointCommand& c, double measured) {
+    const double e = c.angle_rad - measured;
+    if (std::abs(e) > options_.max_following_error_rad) {
+      c.angle_rad = measured + std::copysign(options_.max_following_error_rad, e);
+      ++counters_.following_error_clamped;
+    }
+  };
+  bound(pan_cmd_, head_.angles.pan_rad);
+  bound(tilt_cmd_, head_.angles.tilt_rad);
+  pan_backlash_.place(pan_cmd_.angle_rad);
+  tilt_backlash_.place(tilt_cmd_.angle_rad);
+}
 
-  // A joint that does not follow (stuck, blocked, slower than commanded) must not wind up the
-  // commanded angle: the head would lunge when it frees.
-  if (mode_ != ControlMode::Startup && !has(watchdog_.faults(), Fault::HeadStateStale)) {
-    auto bound = [&](JointCommand& c, double measured) {
-      const double e = c.angle_rad - measured;
-      if (std::abs(e) > options_.max_following_error_rad) {
-        c.angle_rad = measured + std::copysign(options_.max_following_error_rad, e);
-        ++counters_.following_error_clamped;
-      }
-    };
-    bound(pan_cmd_, head_.angles.pan_rad);
-    bound(tilt_cmd_, head_.angles.tilt_rad);
-    pan_backlash_.place(pan_cmd_.angle_rad);
-    tilt_backlash_.place(tilt_cmd_.angle_rad);
-  }
-
+// The mode's desired rates, blended after a switch, through the backlash inverse and the
+// joints' limits into the commands. Returns the output (after-backlash) joint rates.
+Eigen::Vector2d HeadController::shape_commands(double t, double dt, ControlOutput& out) {
   out.target_error_rad = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector2d rates = desired_rates(t, out);
   Eigen::Vector2d output_rates = Eigen::Vector2d::Zero();
-  if (mode_ != ControlMode::Startup) {
-    if (options_.switch_blend_s > 0) {
-      const double a = std::clamp((t - blend_t0_s_) / options_.switch_blend_s, 0.0, 1.0);
-      rates = (1 - a) * blend_from_ + a * rates;
-    }
-    // The camera-rate laws want output rates: through the dead-band inverse to motor rates. Hold
-    // and Park steer the joint angles the encoder measures; the band's model still follows.
-    if (mode_ == ControlMode::Stabilise || mode_ == ControlMode::Fixate) {
-      rates = {pan_backlash_.motor_rate(rates.x(), pan_cmd_, options_.pan, dt),
-               tilt_backlash_.motor_rate(rates.y(), tilt_cmd_, options_.tilt, dt)};
-    }
-    pan_cmd_ = shape(options_.pan, pan_cmd_, rates.x(), dt, out.pan_limits);
-    tilt_cmd_ = shape(options_.tilt, tilt_cmd_, rates.y(), dt, out.tilt_limits);
-    output_rates = {pan_backlash_.follow(pan_cmd_, dt), tilt_backlash_.follow(tilt_cmd_, dt)};
-    counters_.backlash_reversals = pan_backlash_.reversals() + tilt_backlash_.reversals();
-    for (std::uint8_t hits : {out.pan_limits, out.tilt_limits}) {
-      counters_.rate_limited += (hits & kLimitRate) != 0;
-      counters_.accel_limited += (hits & kLimitAccel) != 0;
-      counters_.braking_limited += (hits & kLimitBraking) != 0;
-      counters_.position_limited += (hits & kLimitPosition) != 0;
-    }
+  if (mode_ == ControlMode::Startup) return output_rates;
+  if (options_.switch_blend_s > 0) {
+    const double a = std::clamp((t - blend_t0_s_) / options_.switch_blend_s, 0.0, 1.0);
+    rates = (1 - a) * blend_from_ + a * rates;
   }
+  // The camera-rate laws want output rates: through the dead-band inverse to motor rates. Hold
+  // and Park steer the joint angles the encoder measures; the band's model still follows.
+  if (mode_ == ControlMode::Stabilise || mode_ == ControlMode::Fixate) {
+    rates = {pan_backlash_.motor_rate(rates.x(), pan_cmd_, options_.pan, dt),
+             tilt_backlash_.motor_rate(rates.y(), tilt_cmd_, options_.tilt, dt)};
+  }
+  pan_cmd_ = shape(options_.pan, pan_cmd_, rates.x(), dt, out.pan_limits);
+  tilt_cmd_ = shape(options_.tilt, tilt_cmd_, rates.y(), dt, out.tilt_limits);
+  output_rates = {pan_backlash_.follow(pan_cmd_, dt), tilt_backlash_.follow(tilt_cmd_, dt)};
+  counters_.backlash_reversals = pan_backlash_.reversals() + tilt_backlash_.reversals();
+  for (std::uint8_t hits : {out.pan_limits, out.tilt_limits}) {
+    counters_.rate_limited += (hits & kLimitRate) != 0;
+    counters_.accel_limited += (hits & kLimitAccel) != 0;
+    counters_.braking_limited += (hits & kLimitBraking) != 0;
+    counters_.position_limited += (hits & kLimitPosition) != 0;
+  }
+  return output_rates;
+}
 
+// The command on the wire (withheld at start-up and during bus-off), and its counter.
+void HeadController::encode_command(double t, Eigen::Vector2d output_rates, ControlOutput& out) {
   out.mode = mode_;
   out.requested = requested_;
   out.faults = watchdog_.faults();
@@ -444,7 +464,6 @@ ControlOutput HeadController::step(const ControlInput& in) {
   } else {
     ++counters_.withheld;
   }
-  return out;
 }
 
 }  // namespace epichead::head

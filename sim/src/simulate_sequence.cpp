@@ -16,8 +16,8 @@
 #include "epichead/sim/rig.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/scene_variety.h"
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "occluder_motion.h"
 #include "simulate_random.h"
 

@@ -9,8 +9,8 @@
 
 #include <Eigen/Geometry>
 
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "fuzz_support.h"
 
 using namespace epichead::vision;

@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "epichead/vision/visibility.h"
 #include "common/run_tool.h"
 

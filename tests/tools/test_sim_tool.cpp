@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 
 namespace fs = std::filesystem;
 

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/temp_dir.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 using namespace epichead::vision;
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "epichead/vision/score.h"
+#include "epichead/vision/offline/score.h"
 
 using namespace epichead::vision;
 

@@ -10,7 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 #include "common/temp_dir.h"
 
 using namespace epichead::vision;

@@ -6,7 +6,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "common/temp_dir.h"
 
 using epichead::vision::make_pose;

@@ -11,7 +11,7 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/sequence_writer.h"
 #include "epichead/vision/model_tracker.h"
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 
 namespace epichead::bench {
 namespace {

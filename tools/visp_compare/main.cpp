@@ -14,8 +14,8 @@
 
 #include <opencv2/core/utility.hpp>
 
-#include "epichead/vision/sequence.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/sequence.h"
+#include "epichead/vision/offline/stamped_pose.h"
 #include "overlay.h"
 #include "run_report.h"
 #include "undistorter.h"

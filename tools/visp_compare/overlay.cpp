@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "epichead/vision/overlay.h"
+#include "epichead/vision/offline/overlay.h"
 
 namespace epichead::visp_compare {
 

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/visibility.h"
 #include "undistorter.h"
 #include "visp_tracker.h"

@@ -461,4 +461,11 @@ std::expected<CadModel, std::string> build_model(const RawModel& raw, const std:
   return detail::build_model_located(raw, name, nullptr);
 }
 
+bool on_circle(const ModelCircle& circle, const Eigen::Vector3d& p_obj) {
+  const Eigen::Vector3d n = circle.normal_obj.normalized();
+  const Eigen::Vector3d d = p_obj - circle.centre_obj;
+  const double tol = 1e-3 * circle.radius_m + 1e-6;
+  return std::abs(d.dot(n)) <= tol && std::abs((d - d.dot(n) * n).norm() - circle.radius_m) <= tol;
+}
+
 }  // namespace epichead::vision

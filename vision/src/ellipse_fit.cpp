@@ -6,6 +6,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "ransac_common.h"
+
 namespace epichead::vision {
 namespace {
 
@@ -179,24 +181,13 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     xn_[i] = (x[i] - ox_) * scale_;
     yn_[i] = (y[i] - oy_) * scale_;
   }
-  // A local state, so that the draws stay in registers (as in LineRansac::fit).
-  std::uint32_t rng = 0x9E3779B9u;
-  auto next = [&rng] {  // xorshift32: deterministic and cheap
-    rng ^= rng << 13; rng ^= rng >> 17; rng ^= rng << 5;
-    return rng;
-  };
-  const double log_fail = std::log(1.0 - std::clamp(options_.probability, 0.0, 0.999999));
+  ransac::Xorshift32 rng(options_.seed);  // a local: its state stays in a register
+  const double log_fail = ransac::log_failure(options_.probability);
   const double keep = std::clamp(options_.keep_ratio, 0.0, 1.0);
   // Eq. 4 for 5-point samples; with several candidates wanted, w = keep * inlier ratio so that
   // a candidate at keep * best is also sampled with probability p.
-  auto needed = [&](int best) {
-    const double w = (max_keep > 1 ? keep : 1.0) * static_cast<double>(best) / n_;
-    const double miss = 1.0 - std::pow(w, 5);
-    if (miss <= 0) return 1;
-    if (miss >= 1) return options_.max_iterations;
-    return static_cast<int>(std::min<double>(options_.max_iterations, std::ceil(log_fail / std::log(miss))));
-  };
-  const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
+  const double w_factor = max_keep > 1 ? keep : 1.0;
+  auto same = [this](const Hypothesis& a, const Hypothesis& b) { return same_ellipse(a.ellipse, b.ellipse); };
   int best = 0;
   int budget = options_.max_iterations;
   int sample[5];
@@ -204,7 +195,7 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     // Five points from five different groups (a few redraws; give up on this sample otherwise).
     int got = 0;
     for (int tries = 0; got < 5 && tries < 40; ++tries) {
-      const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n_));
+      const int i = rng.below(n_);
       bool clash = false;
       for (int j = 0; j < got; ++j) clash = clash || sample[j] == i || (group && group[sample[j]] == group[i]);
       if (!clash) sample[got++] = i;
@@ -218,28 +209,13 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     if (!e || !plausible(*e)) continue;
     if (support > best) {
       best = support;
-      budget = std::max(1, needed(best));
+      const double w = w_factor * static_cast<double>(best) / n_;
+      budget = std::max(1, ransac::iterations_needed(log_fail, w, 5, options_.max_iterations));
     }
-    bool merged = false;
-    for (Hypothesis& h : hypotheses_) {
-      if (same_ellipse(h.ellipse, *e)) {
-        if (support > h.support) h = {*e, *k, support};
-        merged = true;
-        break;
-      }
-    }
-    if (merged) continue;
-    if (static_cast<int>(hypotheses_.size()) < hyp_capacity) {
-      hypotheses_.push_back({*e, *k, support});
-    } else {
-      auto weakest = std::min_element(hypotheses_.begin(), hypotheses_.end(),
-                                      [](const Hypothesis& a, const Hypothesis& b) { return a.support < b.support; });
-      if (weakest->support < support) *weakest = {*e, *k, support};
-    }
+    ransac::pool_hypothesis(hypotheses_, Hypothesis{*e, *k, support}, same);
   }
   // Refine: inliers -> direct fit -> inliers -> direct fit -> final inliers.
-  std::sort(hypotheses_.begin(), hypotheses_.end(),
-            [](const Hypothesis& a, const Hypothesis& b) { return a.support > b.support; });
+  ransac::sort_strongest_first(hypotheses_);
   std::fill(claimed_.begin(), claimed_.begin() + n_, 0);
   for (const Hypothesis& h : hypotheses_) {
     // Strongest first: once max_candidates are accepted the rest would be cut below anyway,
@@ -265,10 +241,8 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     for (const EllipseFit& f : candidates_) duplicate = duplicate || same_ellipse(f.ellipse, e);
     if (duplicate) continue;
     // A weaker ellipse must stand on points of its own, not on the inliers of stronger ones.
-    int exclusive = 0;
-    for (int k : scratch_) exclusive += !claimed_[k];
-    if (exclusive < keep * best || exclusive < min_support) continue;
-    for (int k : scratch_) claimed_[k] = 1;
+    if (!ransac::claim_own_points(scratch_.data(), support, claimed_, std::max<double>(keep * best, min_support)))
+      continue;
     EllipseFit fit;
     fit.ellipse = e;
     fit.support = support;
@@ -276,17 +250,7 @@ int EllipseRansac::fit(const double* x, const double* y, const int* group, int n
     inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.end());
     candidates_.push_back(fit);
   }
-  // Insertion sort by support (std::stable_sort would allocate).
-  for (std::size_t i = 1; i < candidates_.size(); ++i)
-    for (std::size_t j = i; j > 0 && candidates_[j].support > candidates_[j - 1].support; --j)
-      std::swap(candidates_[j], candidates_[j - 1]);
-  if (!candidates_.empty()) {
-    const int top = candidates_.front().support;
-    int kept = 0;
-    while (kept < static_cast<int>(candidates_.size()) && kept < max_keep && candidates_[kept].support >= keep * top)
-      ++kept;
-    candidates_.resize(kept);
-  }
+  ransac::sort_and_cut(candidates_, max_keep, keep);
   return static_cast<int>(candidates_.size());
 }
 

@@ -1,5 +1,7 @@
 #include "epichead/vision/fit_line.h"
 
+#include "ransac_common.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -74,32 +76,19 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
   s_begin_ = s_begin;
   s_end_ = s_end;
   const int max_keep = std::max(1, options_.max_candidates);
-  const int hyp_capacity = static_cast<int>(hypotheses_.capacity());
   if (n < std::max(2, options_.min_support)) return 0;
-  // The generator state and the iteration count live in registers during the loop: as members,
-  // each draw and each iteration went through memory (a store-to-load chain from one hypothesis
-  // to the next).
-  std::uint32_t rng = options_.seed != 0 ? options_.seed : 1u;  // 0 is the one state xorshift cannot leave
-  auto next = [&rng] {  // xorshift32: deterministic, cheap, good enough for sampling
-    rng ^= rng << 13; rng ^= rng >> 17; rng ^= rng << 5;
-    return rng;
-  };
-  const double log_fail = std::log(1.0 - std::clamp(options_.probability, 0.0, 0.999999));
+  ransac::Xorshift32 rng(options_.seed);  // a local: its state stays in a register
+  const double log_fail = ransac::log_failure(options_.probability);
   const float keep = std::clamp(options_.keep_ratio, 0.0f, 1.0f);
   // Eq. 4 with w = keep * inlier ratio when several candidates are wanted (see header).
-  auto needed = [&](int best) {
-    const double w = (max_keep > 1 ? keep : 1.0f) * static_cast<double>(best) / n;
-    const double miss = 1.0 - w * w;
-    if (miss <= 0) return 1;
-    if (miss >= 1) return options_.max_iterations;
-    return static_cast<int>(std::min<double>(options_.max_iterations, std::ceil(log_fail / std::log(miss))));
-  };
+  const double w_factor = max_keep > 1 ? keep : 1.0f;
+  auto same = [this](const Hypothesis& a, const Hypothesis& b) { return same_line(a.line, b.line); };
   int best = 0;
   int budget = options_.max_iterations;
-  int iterations = 0;
+  int iterations = 0;  // a local, like the generator
   for (; iterations < budget; ++iterations) {
-    const int i = static_cast<int>(next() % static_cast<std::uint32_t>(n));
-    int j = static_cast<int>(next() % static_cast<std::uint32_t>(n - 1));
+    const int i = rng.below(n);
+    int j = rng.below(n - 1);
     if (j >= i) ++j;
     const float ds = s[j] - s[i];
     if (std::fabs(ds) < 1e-3f) continue;  // same row: no near-vertical line through both
@@ -110,30 +99,15 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
     if (support < options_.min_support) continue;
     if (support > best) {
       best = support;
-      budget = std::max(1, needed(best));
+      const double w = w_factor * static_cast<double>(best) / n;
+      budget = std::max(1, ransac::iterations_needed(log_fail, w, 2, options_.max_iterations));
     }
     if (support < keep * best) continue;
-    // Keep the strongest hypothesis per distinct line.
-    bool merged = false;
-    for (auto& h : hypotheses_) {
-      if (same_line(h.line, line)) {
-        if (support > h.support) h = {line, support};
-        merged = true;
-        break;
-      }
-    }
-    if (merged) continue;
-    if (static_cast<int>(hypotheses_.size()) < hyp_capacity) {
-      hypotheses_.push_back({line, support});
-    } else {
-      auto weakest = std::min_element(hypotheses_.begin(), hypotheses_.end(),
-                                      [](const Hypothesis& a, const Hypothesis& b) { return a.support < b.support; });
-      if (weakest->support < support) *weakest = {line, support};
-    }
+    ransac::pool_hypothesis(hypotheses_, Hypothesis{line, support}, same);  // strongest per distinct line
   }
   iterations_ = iterations;
   // Refine each surviving hypothesis: inliers -> TLS -> inliers -> TLS -> final inliers.
-  std::sort(hypotheses_.begin(), hypotheses_.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.support > b.support; });
+  ransac::sort_strongest_first(hypotheses_);
   const float tol = options_.inlier_distance_px;
   std::fill(claimed_.begin(), claimed_.begin() + n, 0);
   // The points within tol of a line into scratch_: WindowLine::distance with its root taken
@@ -173,10 +147,8 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
     // A line that lives on points already claimed by stronger candidates is no line of its
     // own: two close parallel edges make diagonals that cross both within the inlier band.
     // Hypotheses come strongest first, so this is decided in support order.
-    int exclusive = 0;
-    for (int q = 0; q < support; ++q) exclusive += !claimed_[scratch_[q]];
-    if (exclusive < keep * best || exclusive < options_.min_support) continue;
-    for (int q = 0; q < support; ++q) claimed_[scratch_[q]] = 1;
+    if (!ransac::claim_own_points(scratch_.data(), support, claimed_, std::max<double>(keep * best, options_.min_support)))
+      continue;
     LineFit fit;
     fit.line = line;
     fit.support = support;
@@ -184,16 +156,7 @@ int LineRansac::fit(const float* x, const float* s, int n, float s_begin, float 
     inliers_.insert(inliers_.end(), scratch_.begin(), scratch_.begin() + support);
     candidates_.push_back(fit);
   }
-  // Insertion sort (a handful of candidates; std::stable_sort would allocate a buffer).
-  for (std::size_t i = 1; i < candidates_.size(); ++i)
-    for (std::size_t j = i; j > 0 && candidates_[j].support > candidates_[j - 1].support; --j)
-      std::swap(candidates_[j], candidates_[j - 1]);
-  if (!candidates_.empty()) {
-    const int top = candidates_.front().support;
-    int kept = 0;
-    while (kept < static_cast<int>(candidates_.size()) && kept < max_keep && candidates_[kept].support >= keep * top) ++kept;
-    candidates_.resize(kept);
-  }
+  ransac::sort_and_cut(candidates_, max_keep, keep);
   return static_cast<int>(candidates_.size());
 }
 

@@ -54,6 +54,70 @@ __attribute__((target("avx2"))) void row_taps_avx2(const float* px, std::size_t 
 const bool kHaveAvx2 = __builtin_cpu_supports("avx2");
 #endif
 
+#if defined(__SSE4_1__)
+// Requests the source lines of a window row starting at (x1, y1) ahead of its taps: one prefetch
+// per cache line and image row, every `step`-th sample (see sample()).
+inline void prefetch_row(const float* px, std::size_t stride, int w, float x1, float y1, float ax, float ay, int cols,
+                         int step) {
+  for (int q = 0; q < cols; q += step) {
+    const int ix = static_cast<int>(x1 + static_cast<float>(q) * ax), iy = static_cast<int>(y1 + static_cast<float>(q) * ay);
+    const char* a = reinterpret_cast<const char*>(px + 4 * (static_cast<std::size_t>(iy) * w + ix));
+    _mm_prefetch(a, _MM_HINT_T0);
+    _mm_prefetch(a + stride * sizeof(float), _MM_HINT_T0);
+  }
+}
+
+// The first pass of a row (see sample()): the image offset (in floats) and the bilinear
+// fractions of columns [0, groups), four per register; clamped into the image unless the whole
+// window is inside.
+inline void row_offsets(float x0, float y0, float ax, float ay, bool inside, float xmax, float ymax, int w, int groups,
+                        std::int32_t* off, float* fxs, float* fys) {
+  const __m128 vx0 = _mm_set1_ps(x0), vy0 = _mm_set1_ps(y0);
+  const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
+  const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
+  const __m128i vw = _mm_set1_epi32(w);
+  // Column numbers as floats, stepped by 4 (exact: small integers).
+  __m128 vc = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f);
+  const __m128 four = _mm_set1_ps(4.0f);
+  for (int q = 0; q < groups; q += 4, vc = _mm_add_ps(vc, four)) {
+    __m128 x = _mm_add_ps(vx0, _mm_mul_ps(vc, vax)), y = _mm_add_ps(vy0, _mm_mul_ps(vc, vay));
+    if (!inside) {
+      x = _mm_min_ps(_mm_max_ps(x, zero), vxmax);
+      y = _mm_min_ps(_mm_max_ps(y, zero), vymax);
+    }
+    const __m128i ix = _mm_cvttps_epi32(x), iy = _mm_cvttps_epi32(y);
+    _mm_store_ps(fxs + q, _mm_sub_ps(x, _mm_cvtepi32_ps(ix)));
+    _mm_store_ps(fys + q, _mm_sub_ps(y, _mm_cvtepi32_ps(iy)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(off + q), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
+  }
+}
+
+// The second pass of a row, columns [c, groups): four all-channel taps at a time and a 4x4
+// transpose into the four planes (pi.. point at the row's first column), with the scalar tap's
+// arithmetic, so the same values.
+inline void row_taps(const float* px, std::size_t stride, const std::int32_t* off, const float* fxs, const float* fys,
+                     int c, int groups, float* pi, float* pr, float* pg, float* pt) {
+  for (; c < groups; c += 4) {
+    __m128 v[4];
+    for (int k = 0; k < 4; ++k) {
+      const float* q0 = px + off[c + k];
+      const float* q1 = q0 + stride;
+      const __m128 vfx = _mm_load1_ps(fxs + c + k), vfy = _mm_load1_ps(fys + c + k);
+      const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
+      const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
+      const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
+      const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
+      v[k] = _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top)));
+    }
+    _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
+    _mm_storeu_ps(pi + c, v[0]);
+    _mm_storeu_ps(pr + c, v[1]);
+    _mm_storeu_ps(pg + c, v[2]);
+    _mm_storeu_ps(pt + c, v[3]);
+  }
+}
+#endif
+
 }  // namespace
 
 RowPlan plan_rows(double length_px, const WindowOptions& options) {
@@ -137,76 +201,29 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
 #if defined(__SSE4_1__)
     // The next row's source lines are requested while this row is interpolated: on a full-size
     // frame (4.9 MB of cue pixels at 640 x 480) a window's taps mostly miss the caches, and a
-    // window across a near-horizontal line touches two new lines per sample. One prefetch per
-    // line and image row: every prefetch_step-th sample. A frame that fits in the L2 cache
-    // (such as epic_window's 120 x 120) gains nothing from it and skips it.
+    // window across a near-horizontal line touches two new lines per sample. A frame that fits
+    // in the L2 cache (such as epic_window's 120 x 120) gains nothing from it and skips it.
     if (prefetch && r + 1 < g.rows) {
       const Eigen::Vector2d p1 = g.to_image(g.x_of_col(0), g.s_of_row(r + 1));
-      const float x1 = static_cast<float>(p1.x()), y1 = static_cast<float>(p1.y());
-      for (int q = 0; q < g.cols; q += prefetch_step) {
-        const int ix = static_cast<int>(x1 + static_cast<float>(q) * ax), iy = static_cast<int>(y1 + static_cast<float>(q) * ay);
-        const char* a = reinterpret_cast<const char*>(px + 4 * (static_cast<std::size_t>(iy) * w + ix));
-        _mm_prefetch(a, _MM_HINT_T0);
-        _mm_prefetch(a + stride * sizeof(float), _MM_HINT_T0);
-      }
+      prefetch_row(px, stride, w, static_cast<float>(p1.x()), static_cast<float>(p1.y()), ax, ay, g.cols, prefetch_step);
     }
-#endif
-#if defined(__SSE4_1__)
-    // Two passes over the row, four columns per register. First every column's image offset and
-    // fractions (vector arithmetic only); then four all-channel taps at a time and a 4x4
-    // transpose into the four planes, with the scalar tap's arithmetic (so the same values). The
-    // taps' loads then wait on nothing but these small arrays: in one pass each tap's loads sat
-    // at the end of the coordinate chain and the taps could not overlap.
+    // Two passes over the row, four columns per register: first every column's image offset and
+    // fractions (vector arithmetic only), then the taps. The taps' loads then wait on nothing but
+    // these small arrays: in one pass each tap's loads sat at the end of the coordinate chain
+    // and the taps could not overlap.
     {
-      const __m128 vx0 = _mm_set1_ps(x0), vy0 = _mm_set1_ps(y0);
-      const __m128 vax = _mm_set1_ps(ax), vay = _mm_set1_ps(ay);
-      const __m128 vxmax = _mm_set1_ps(xmax), vymax = _mm_set1_ps(ymax), zero = _mm_setzero_ps();
-      const __m128i vw = _mm_set1_epi32(w);
       alignas(16) std::int32_t off[kMaxWindowWidth];
       alignas(16) float fxs[kMaxWindowWidth], fys[kMaxWindowWidth];
       const int groups = g.cols / 4 * 4;
-      // Column numbers as floats, stepped by 4 (exact: small integers).
-      __m128 vc = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f);
-      const __m128 four = _mm_set1_ps(4.0f);
-      for (int q = 0; q < groups; q += 4, vc = _mm_add_ps(vc, four)) {
-        __m128 x = _mm_add_ps(vx0, _mm_mul_ps(vc, vax)), y = _mm_add_ps(vy0, _mm_mul_ps(vc, vay));
-        if (!inside) {
-          x = _mm_min_ps(_mm_max_ps(x, zero), vxmax);
-          y = _mm_min_ps(_mm_max_ps(y, zero), vymax);
-        }
-        const __m128i ix = _mm_cvttps_epi32(x), iy = _mm_cvttps_epi32(y);
-        _mm_store_ps(fxs + q, _mm_sub_ps(x, _mm_cvtepi32_ps(ix)));
-        _mm_store_ps(fys + q, _mm_sub_ps(y, _mm_cvtepi32_ps(iy)));
-        _mm_store_si128(reinterpret_cast<__m128i*>(off + q), _mm_slli_epi32(_mm_add_epi32(_mm_mullo_epi32(iy, vw), ix), 2));
-      }
+      row_offsets(x0, y0, ax, ay, inside, xmax, ymax, w, groups, off, fxs, fys);
 #if defined(EPICHEAD_WARP_AVX2)
       if (kHaveAvx2 && options_.allow_avx2) {
         row_taps_avx2(px, stride, off, fxs, fys, groups, pi + base, pr + base, pg + base, pt + base);
         c = groups;
       }
 #endif
-      for (; c < groups; c += 4) {
-        __m128 v[4];
-        auto lerp = [&](int k) {
-          const float* q0 = px + off[c + k];
-          const float* q1 = q0 + stride;
-          const __m128 vfx = _mm_load1_ps(fxs + c + k), vfy = _mm_load1_ps(fys + c + k);
-          const __m128 a0 = _mm_loadu_ps(q0), b0 = _mm_loadu_ps(q0 + 4);
-          const __m128 a1 = _mm_loadu_ps(q1), b1 = _mm_loadu_ps(q1 + 4);
-          const __m128 top = _mm_add_ps(a0, _mm_mul_ps(vfx, _mm_sub_ps(b0, a0)));
-          const __m128 bot = _mm_add_ps(a1, _mm_mul_ps(vfx, _mm_sub_ps(b1, a1)));
-          v[k] = _mm_add_ps(top, _mm_mul_ps(vfy, _mm_sub_ps(bot, top)));
-        };
-        lerp(0);
-        lerp(1);
-        lerp(2);
-        lerp(3);
-        _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
-        _mm_storeu_ps(pi + base + c, v[0]);
-        _mm_storeu_ps(pr + base + c, v[1]);
-        _mm_storeu_ps(pg + base + c, v[2]);
-        _mm_storeu_ps(pt + base + c, v[3]);
-      }
+      row_taps(px, stride, off, fxs, fys, c, groups, pi + base, pr + base, pg + base, pt + base);
+      c = groups;
     }
 #endif
     for (; c < g.cols; ++c) {

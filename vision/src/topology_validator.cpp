@@ -130,21 +130,28 @@ double TopologyValidator::junction_evidence(const WindowImage& image, const Eige
 }
 
 void TopologyValidator::validate(const WindowImage& image, const std::vector<LineFeature>& features, ValidationResult& out) {
-  const CadModel& model = *model_;
-  const int edges = static_cast<int>(std::min(features.size(), model.edges.size()));
-  out.selected.assign(model.edges.size(), -1);
-  out.votes.assign(model.edges.size(), 0);
-  out.relations.assign(model.edges.size(), 0);
+  const int edges = static_cast<int>(std::min(features.size(), model_->edges.size()));
+  out.selected.assign(model_->edges.size(), -1);
+  out.votes.assign(model_->edges.size(), 0);
+  out.relations.assign(model_->edges.size(), 0);
   out.junctions.clear();
   out.junction_relations = out.parallel_relations = out.combinations = out.changed = 0;
   std::fill(votes_.begin(), votes_.end(), 0);
-  std::fill(corner_sum_.begin(), corner_sum_.end(), Eigen::Vector2d::Zero());
-  std::fill(corner_count_.begin(), corner_count_.end(), 0);
-  std::fill(corner_evidence_.begin(), corner_evidence_.end(), 0.0);
-  auto vote = [&](int edge, int cand) { ++votes_[static_cast<std::size_t>(edge) * kMaxValidated + cand]; };
+  vote_junctions(image, features, edges, out);
+  vote_parallels(features, edges, out);
+  select_majority(features, edges, out);
+  locate_junctions(image, features, edges, out);
+}
 
-  // Connectivity: every pair of usable edges at every junction in view; the combination with the
-  // best evidence votes for its two candidates.
+void TopologyValidator::vote(int edge, int candidate) {
+  ++votes_[static_cast<std::size_t>(edge) * kMaxValidated + candidate];
+}
+
+// Connectivity: every pair of usable edges at every junction in view; the combination with the
+// best evidence votes for its two candidates.
+void TopologyValidator::vote_junctions(const WindowImage& image, const std::vector<LineFeature>& features, int edges,
+                                       ValidationResult& out) {
+  const CadModel& model = *model_;
   for (const ModelJunction& j : model.junctions) {
     const int m = static_cast<int>(j.edges.size());
     for (int x = 0; x < m; ++x) {
@@ -191,8 +198,11 @@ void TopologyValidator::validate(const WindowImage& image, const std::vector<Lin
       }
     }
   }
+}
 
-  // Parallelism: each usable edge with its nearest usable model-parallel partners.
+// Parallelism: each usable edge with its nearest usable model-parallel partners; the pair of
+// candidates whose angle and distance best match the projection's votes.
+void TopologyValidator::vote_parallels(const std::vector<LineFeature>& features, int edges, ValidationResult& out) {
   for (int ea = 0; ea < edges; ++ea) {
     if (!usable(features[ea])) continue;
     const VisibleEdge& pa = features[ea].piece;
@@ -235,8 +245,10 @@ void TopologyValidator::validate(const WindowImage& image, const std::vector<Lin
       vote(eb, best_b);
     }
   }
+}
 
-  // Majority per feature; ties go to the stronger RANSAC candidate (lower index).
+// Majority per feature; ties go to the stronger RANSAC candidate (lower index).
+void TopologyValidator::select_majority(const std::vector<LineFeature>& features, int edges, ValidationResult& out) const {
   for (int e = 0; e < edges; ++e) {
     if (!usable(features[e])) continue;
     int best = 0;
@@ -247,9 +259,16 @@ void TopologyValidator::validate(const WindowImage& image, const std::vector<Lin
     out.votes[e] = v[best];
     out.changed += best != 0;
   }
+}
 
-  // Junction positions from the selected candidates: every pair at a junction whose two
-  // selected lines intersect near the projection and visibly reach the corner.
+// Junction positions from the selected candidates: every pair at a junction whose two selected
+// lines intersect near the projection and visibly reach the corner.
+void TopologyValidator::locate_junctions(const WindowImage& image, const std::vector<LineFeature>& features, int edges,
+                                         ValidationResult& out) {
+  const CadModel& model = *model_;
+  std::fill(corner_sum_.begin(), corner_sum_.end(), Eigen::Vector2d::Zero());
+  std::fill(corner_count_.begin(), corner_count_.end(), 0);
+  std::fill(corner_evidence_.begin(), corner_evidence_.end(), 0.0);
   for (const ModelJunction& j : model.junctions) {
     const int m = static_cast<int>(j.edges.size());
     for (int x = 0; x < m; ++x) {

@@ -22,8 +22,11 @@ struct PredictorOptions {
   double imu_time_offset_sigma_s = 0;
   double imu_rate_hz = 1000;            // nominal; sizes the ring
   double buffer_s = 0.5;                // how late a vision pose may be
-  double gyro_range_radps = 1e300;      // a reading at or beyond +-range on any axis is saturated
-  double accel_range_mps2 = 1e300;
+  // A reading at or beyond +-range on any axis is saturated (dropped, counted). The defaults are
+  // beyond any MEMS sensor (57 000 deg/s, ~1000 g): without the sensor's own range a larger
+  // reading is still garbage (a corrupt log, a unit mix-up), never a motion to integrate.
+  double gyro_range_radps = 1000;
+  double accel_range_mps2 = 10000;
   double dropout_gap_s = 0.0035;        // a gap between samples longer than this is a dropout
   // Over a gap the readings are unknown, not linear: the error covariance of a step longer than
   // dropout_gap_s (and of an extrapolation that long) grows by a random rate and acceleration of

@@ -171,6 +171,13 @@ class HeadController {
   void ingest(const ControlInput& in);
   void enter(ControlMode mode, ModeReason reason, double t_s, ControlOutput& out);
   Eigen::Vector2d desired_rates(double t_s, ControlOutput& out);
+  // The stages of step(), in order (head_controller.cpp says what each does).
+  double advance_clock(double t_s);
+  FaultChange supervise(double t_s, bool bus_off, ControlOutput& out);
+  void bound_following_error();
+  Eigen::Vector2d shape_commands(double t_s, double dt, ControlOutput& out);
+  void encode_command(double t_s, Eigen::Vector2d output_rates, ControlOutput& out);
+  void command_from_head();
   Eigen::Vector2d camera_rate_law(const Eigen::Vector2d& camera_rate_xy_radps) const;
   void update_body_rate();
   void emit(ControlOutput& out, const HeadEvent& e);

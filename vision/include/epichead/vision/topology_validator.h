@@ -75,6 +75,14 @@ class TopologyValidator {
   void validate(const WindowImage& image, const std::vector<LineFeature>& features, ValidationResult& out);
 
  private:
+  // The stages of validate(), in order.
+  void vote_junctions(const WindowImage& image, const std::vector<LineFeature>& features, int edges,
+                      ValidationResult& out);
+  void vote_parallels(const std::vector<LineFeature>& features, int edges, ValidationResult& out);
+  void select_majority(const std::vector<LineFeature>& features, int edges, ValidationResult& out) const;
+  void locate_junctions(const WindowImage& image, const std::vector<LineFeature>& features, int edges,
+                        ValidationResult& out);
+  void vote(int edge, int candidate);
   double junction_evidence(const WindowImage& image, const Eigen::Vector2d& corner_px,
                            const Eigen::Vector2d& into_edge, const LineCandidate& c);
   const CadModel* model_;

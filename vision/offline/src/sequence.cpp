@@ -1,4 +1,4 @@
-#include "epichead/vision/sequence.h"
+#include "epichead/vision/offline/sequence.h"
 
 #include <cmath>
 #include <filesystem>

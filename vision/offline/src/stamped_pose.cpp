@@ -1,4 +1,4 @@
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 #include <array>
 #include <cmath>

@@ -11,7 +11,7 @@
 
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
-#include "epichead/vision/stamped_pose.h"
+#include "epichead/vision/offline/stamped_pose.h"
 
 namespace epichead::vision {
 

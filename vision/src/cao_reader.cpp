@@ -1,4 +1,4 @@
-// ViSP's CAO model format (V1): reader with load() includes, and writer.
+// ViSP's CAO model format (V1): the reader, with load() includes (the writer: cao_writer.cpp).
 //
 // ViSP reads a CAO file as a stream of tokens (with `#` comment lines), so tokens may be spread
 // over lines freely; we do the same but keep the line of every token for messages. Sections, in
@@ -9,168 +9,31 @@
 #include "epichead/vision/cao_model.h"
 
 #include <algorithm>
-#include <charconv>
+#include <array>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <map>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
-#include <sstream>
 #include <string_view>
 #include <system_error>
 
 #include <Eigen/Geometry>
 
 #include "cao_build.h"
+#include "cao_text.h"
 
 namespace epichead::vision {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr long long kMaxCount = 10'000'000;  // per section; real models are far below
-constexpr int kMaxLoadDepth = 16;
-constexpr int kMaxLoadedFiles = 1000;
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
-
-struct Token {
-  std::string_view text;  // empty at the end of the input
-  int line = 0;
-  bool end() const { return text.empty(); }
-};
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
-
-// Splits CAO text into whitespace-separated tokens, dropping `#` and `//` comments (ViSP's
-// documentation writes `//` after values), counting lines for messages.
-class Lexer {
- public:
-  explicit Lexer(std::string_view text) : text_(text) {
-    if (text_.starts_with("\xEF\xBB\xBF")) pos_ = 3;  // UTF-8 byte order mark
-  }
-
-  Token next() {
-    skip_blank();
-    if (pos_ >= text_.size()) {
-      // The end is on the last line, not on the empty one after a final line break.
-      const bool final_break = !text_.empty() && text_.back() == '\n';
-      return {{}, std::max(1, line_ - (final_break ? 1 : 0))};
-    }
-    const std::size_t start = pos_;
-    while (pos_ < text_.size() && !is_space(text_[pos_]) && text_[pos_] != '#') {
-      if (text_[pos_] == '"' && pos_ > start && text_[pos_ - 1] == '=') {
-        // name="a b": a quoted attribute value may hold blanks, not a line break.
-        const std::size_t close = text_.find_first_of("\"\n", pos_ + 1);
-        pos_ = close == std::string_view::npos ? text_.size() : (text_[close] == '"' ? close + 1 : close);
-        continue;
-      }
-      ++pos_;
-    }
-    return {text_.substr(start, pos_ - start), line_};
-  }
-
-  Token peek() {
-    const std::size_t pos = pos_;
-    const int line = line_;
-    const Token t = next();
-    pos_ = pos;
-    line_ = line;
-    return t;
-  }
-
-  // The rest of the line from the start of `t` (a token from peek()), consumed.
-  std::string_view take_line(const Token& t) {
-    const auto start = static_cast<std::size_t>(t.text.data() - text_.data());
-    std::size_t end = text_.find('\n', start);
-    if (end == std::string_view::npos) end = text_.size();
-    pos_ = end;
-    line_ = t.line;
-    return text_.substr(start, end - start);
-  }
-
-  int line() const { return line_; }
-
- private:
-  void skip_blank() {
-    while (pos_ < text_.size()) {
-      const char c = text_[pos_];
-      if (is_space(c)) {
-        line_ += c == '\n';
-        ++pos_;
-      } else if (c == '#' || (c == '/' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '/')) {
-        const std::size_t eol = text_.find('\n', pos_);
-        pos_ = eol == std::string_view::npos ? text_.size() : eol;
-      } else {
-        break;
-      }
-    }
-  }
-
-  std::string_view text_;
-  std::size_t pos_ = 0;
-  int line_ = 1;
-};
-
-// A token as it appears in a message: quoted, shortened, control bytes escaped.
-std::string shown(const Token& t) {
-  if (t.end()) return "end of file";
-  std::string out = "'";
-  const std::size_t n = std::min<std::size_t>(t.text.size(), 40);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(t.text[i]);
-    if (c < 0x20 || c >= 0x7f) {
-      static const char* hex = "0123456789abcdef";
-      out += "\\x";
-      out += hex[c >> 4];
-      out += hex[c & 15];
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  if (t.text.size() > n) out += "...";
-  return out + "'";
-}
-
-bool parse_integer(std::string_view s, long long& value, bool& overflow) {
-  overflow = false;
-  if (s.starts_with('+')) s.remove_prefix(1);
-  if (s.empty()) return false;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
-  if (end != s.data() + s.size()) return false;
-  if (ec == std::errc::result_out_of_range) overflow = true;
-  return ec == std::errc{} || overflow;
-}
+using namespace cao_text;  // the tokens, numbers and file reading of cao_text.h
 
 // How errors state the bound on coordinates, radii and translations.
 const std::string kExtentText = "the 1e6 m a physical model can have";
 
-// A finite decimal number taking the whole of `s`.
-bool parse_number(std::string_view s, double& value) {
-  if (s.starts_with('+')) s.remove_prefix(1);
-  if (s.empty()) return false;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
-  return ec == std::errc{} && end == s.data() + s.size() && std::isfinite(value);
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::expected<std::string, std::string> read_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return std::unexpected(path.string() + ": cannot open (no such file)");
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec || size > kMaxFileBytes) return std::unexpected(path.string() + ": cannot read (unreadable or too large)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::unexpected(path.string() + ": cannot open");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return std::unexpected(path.string() + ": read error");
-  return std::move(buffer).str();
-}
+constexpr long long kMaxCount = 10'000'000;  // per section; real models are far below
+constexpr int kMaxLoadDepth = 16;
+constexpr int kMaxLoadedFiles = 1000;
 
 // Files being loaded, outermost first: canonical path (to find cycles) and name for messages.
 struct LoadChain {
@@ -270,6 +133,18 @@ class Parser {
     if (!i) return i;
     return *i + point_offset_;
   }
+  // N point indices in a row (a line's ends, a cylinder's axis, a circle's centre and plane),
+  // with their tokens for messages.
+  template <std::size_t N>
+  std::expected<void, std::string> read_point_indices(std::array<Token, N>& t, std::array<int, N>& idx) {
+    for (std::size_t k = 0; k < N; ++k) {
+      auto p = read_point(t[k]);
+      if (!p) return std::unexpected(p.error());
+      idx[k] = *p;
+    }
+    return {};
+  }
+
 
   template <class What>
   std::expected<double, std::string> read_number(const What& what, Token& t) {
@@ -438,17 +313,15 @@ class Parser {
     auto n = read_count("number of lines");
     if (!n) return std::unexpected(n.error());
     for (long long k = 0; k < *n; ++k) {
-      Token ta, tb;
-      auto a = read_point(ta);
-      if (!a) return std::unexpected(a.error());
-      auto b = read_point(tb);
-      if (!b) return std::unexpected(b.error());
-      if (*a == *b || acc_.raw.vertices[*a] == acc_.raw.vertices[*b]) {
-        return fail(tb, "line has equal end points (" + std::string(ta.text) + " " + std::string(tb.text) + ")");
+      std::array<Token, 2> t;
+      std::array<int, 2> p;
+      if (auto ok = read_point_indices(t, p); !ok) return ok;
+      if (p[0] == p[1] || acc_.raw.vertices[p[0]] == acc_.raw.vertices[p[1]]) {
+        return fail(t[1], "line has equal end points (" + std::string(t[0].text) + " " + std::string(t[1].text) + ")");
       }
-      lines_.push_back({*a, *b});
-      acc_.raw.free_lines.push_back({*a, *b});  // merged into face edges they lie on
-      acc_.where.lines.push_back(at(ta));
+      lines_.push_back(p);
+      acc_.raw.free_lines.push_back({p[0], p[1]});  // merged into face edges they lie on
+      acc_.where.lines.push_back(at(t[0]));
     }
     return {};
   }
@@ -542,20 +415,18 @@ class Parser {
     auto n = read_count("number of cylinders");
     if (!n) return std::unexpected(n.error());
     for (long long k = 0; k < *n; ++k) {
-      Token ta, tb;
-      auto a = read_point(ta);
-      if (!a) return std::unexpected(a.error());
-      auto b = read_point(tb);
-      if (!b) return std::unexpected(b.error());
+      std::array<Token, 2> t;
+      std::array<int, 2> p;
+      if (auto ok = read_point_indices(t, p); !ok) return ok;
       auto r = read_radius();
       if (!r) return std::unexpected(r.error());
       ModelCylinder c;
-      c.axis_a_obj = acc_.raw.vertices[*a];
-      c.axis_b_obj = acc_.raw.vertices[*b];
+      c.axis_a_obj = acc_.raw.vertices[p[0]];
+      c.axis_b_obj = acc_.raw.vertices[p[1]];
       c.radius_m = *r;
-      if (c.axis_a_obj == c.axis_b_obj) return fail(tb, "cylinder axis points are equal");
+      if (c.axis_a_obj == c.axis_b_obj) return fail(t[1], "cylinder axis points are equal");
       acc_.raw.cylinders.push_back(c);
-      acc_.where.cylinders.push_back(at(ta));
+      acc_.where.cylinders.push_back(at(t[0]));
     }
     return {};
   }
@@ -569,17 +440,13 @@ class Parser {
       const Token head = value_token_peek();
       auto r = read_radius();
       if (!r) return std::unexpected(r.error());
-      Token tc, t1, t2;
-      auto c = read_point(tc);
-      if (!c) return std::unexpected(c.error());
-      auto p1 = read_point(t1);
-      if (!p1) return std::unexpected(p1.error());
-      auto p2 = read_point(t2);
-      if (!p2) return std::unexpected(p2.error());
-      const Eigen::Vector3d& centre = acc_.raw.vertices[*c];
-      const Eigen::Vector3d normal = (acc_.raw.vertices[*p1] - centre).cross(acc_.raw.vertices[*p2] - centre);
+      std::array<Token, 3> t;
+      std::array<int, 3> p;  // centre, two points of the plane
+      if (auto ok = read_point_indices(t, p); !ok) return ok;
+      const Eigen::Vector3d& centre = acc_.raw.vertices[p[0]];
+      const Eigen::Vector3d normal = (acc_.raw.vertices[p[1]] - centre).cross(acc_.raw.vertices[p[2]] - centre);
       if (!(normal.norm() > 0) || !normal.allFinite()) {
-        return fail(t2, "circle's plane points are collinear with its centre");
+        return fail(t[2], "circle's plane points are collinear with its centre");
       }
       acc_.raw.circles.push_back({centre, normal.normalized(), *r});
       acc_.where.circles.push_back(at(head));
@@ -610,12 +477,6 @@ std::expected<CadModel, std::string> parse_top(const std::string& text, const st
   return detail::build_model_located(acc.raw, name, &acc.where);
 }
 
-void put_number(std::string& out, double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
-  out.append(buf, ec == std::errc{} ? end : buf);
-}
-
 }  // namespace
 
 std::expected<CadModel, std::string> load_cao(const std::string& path) {
@@ -632,95 +493,6 @@ std::expected<CadModel, std::string> parse_cao(const std::string& text, const st
   std::error_code ec;
   const fs::path dir = base_dir.empty() ? fs::path(".") : fs::path(base_dir);
   return parse_top(text, name, dir, fs::weakly_canonical(dir / name, ec).string());
-}
-
-std::string to_cao(const CadModel& model) {
-  // Circles and cylinders refer to points: reuse model vertices at exactly the same place (so
-  // a model read from a file reads back with the same vertices), else append points.
-  std::vector<Eigen::Vector3d> points = model.vertices;
-  std::map<std::array<double, 3>, int> where;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    where.try_emplace({points[i].x(), points[i].y(), points[i].z()}, static_cast<int>(i));
-  }
-  auto point_at = [&](const Eigen::Vector3d& p) {
-    const auto [it, added] = where.try_emplace({p.x(), p.y(), p.z()}, static_cast<int>(points.size()));
-    if (added) points.push_back(p);
-    return it->second;
-  };
-  std::vector<std::array<int, 2>> cylinders;
-  for (const ModelCylinder& c : model.cylinders) cylinders.push_back({point_at(c.axis_a_obj), point_at(c.axis_b_obj)});
-  std::vector<std::array<int, 3>> circles;
-  for (const ModelCircle& c : model.circles) {
-    const int centre = point_at(c.centre_obj);
-    const Eigen::Vector3d n = c.normal_obj.normalized();
-    // Two vertices already in the circle's plane whose cross product gives its normal, if any
-    // (a few candidates only: this is for models read from CAO, where they exist).
-    int p1 = -1, p2 = -1;
-    int tries = 0;
-    for (std::size_t a = 0; a < model.vertices.size() && p1 < 0 && tries < 8; ++a) {
-      const Eigen::Vector3d da = model.vertices[a] - c.centre_obj;
-      if (!(da.norm() > 0) || std::abs(n.dot(da)) > 1e-9 * da.norm()) continue;
-      ++tries;
-      for (std::size_t b = 0; b < model.vertices.size(); ++b) {
-        const Eigen::Vector3d cross = da.cross(model.vertices[b] - c.centre_obj);
-        if (cross.norm() > 0 && n.dot(cross.normalized()) > 1 - 1e-14) {
-          p1 = static_cast<int>(a);
-          p2 = static_cast<int>(b);
-          break;
-        }
-      }
-    }
-    if (p1 < 0) {
-      const Eigen::Vector3d u = n.unitOrthogonal();
-      p1 = point_at(c.centre_obj + c.radius_m * u);
-      p2 = point_at(c.centre_obj + c.radius_m * n.cross(u));
-    }
-    circles.push_back({centre, p1, p2});
-  }
-
-  std::string out = "V1\n# Written by epichead\n# 3D Points\n" + std::to_string(points.size()) + "\n";
-  for (const Eigen::Vector3d& p : points) {
-    put_number(out, p.x());
-    out += ' ';
-    put_number(out, p.y());
-    out += ' ';
-    put_number(out, p.z());
-    out += '\n';
-  }
-  std::string lines;
-  std::size_t line_count = 0;
-  for (const ModelEdge& e : model.edges) {
-    if (e.face_count() != 0 || e.extra_faces != 0) continue;
-    lines += std::to_string(e.v0) + " " + std::to_string(e.v1) + "\n";
-    ++line_count;
-  }
-  out += "# 3D Lines\n" + std::to_string(line_count) + "\n" + lines;
-  out += "# Faces from 3D lines\n0\n# Faces from 3D points\n" + std::to_string(model.faces.size()) + "\n";
-  for (const ModelFace& f : model.faces) {
-    out += std::to_string(f.vertices.size());
-    for (int v : f.vertices) out += " " + std::to_string(v);
-    out += '\n';
-  }
-  out += "# 3D cylinders\n" + std::to_string(cylinders.size()) + "\n";
-  for (std::size_t i = 0; i < cylinders.size(); ++i) {
-    out += std::to_string(cylinders[i][0]) + " " + std::to_string(cylinders[i][1]) + " ";
-    put_number(out, model.cylinders[i].radius_m);
-    out += '\n';
-  }
-  out += "# 3D circles\n" + std::to_string(circles.size()) + "\n";
-  for (std::size_t i = 0; i < circles.size(); ++i) {
-    put_number(out, model.circles[i].radius_m);
-    out += " " + std::to_string(circles[i][0]) + " " + std::to_string(circles[i][1]) + " " +
-           std::to_string(circles[i][2]) + "\n";
-  }
-  return out;
-}
-
-bool on_circle(const ModelCircle& circle, const Eigen::Vector3d& p_obj) {
-  const Eigen::Vector3d n = circle.normal_obj.normalized();
-  const Eigen::Vector3d d = p_obj - circle.centre_obj;
-  const double tol = 1e-3 * circle.radius_m + 1e-6;
-  return std::abs(d.dot(n)) <= tol && std::abs((d - d.dot(n) * n).norm() - circle.radius_m) <= tol;
 }
 
 }  // namespace epichead::vision

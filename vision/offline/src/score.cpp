@@ -1,4 +1,4 @@
-#include "epichead/vision/score.h"
+#include "epichead/vision/offline/score.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "epichead/vision/overlay.h"
+#include "epichead/vision/offline/overlay.h"
 
 #include <cmath>
 
