@@ -3,15 +3,19 @@
 // described in run_config.h.
 #include <CLI/CLI.hpp>
 
+#include <signal.h>
 #include <time.h>
 
 #include <cmath>
 #include <cstdio>
+#include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 
 #include "command.h"
+#include "onboard_summary_json.h"
 #include "run_config.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/hw/clock.h"
@@ -26,6 +30,12 @@ namespace epichead::tools {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Ctrl-C or SIGTERM ends the run after the current tick, so the logs and the summary are written.
+std::atomic<head::OnboardLoop*> running_loop{nullptr};
+extern "C" void on_stop_signal(int) {
+  if (head::OnboardLoop* loop = running_loop.load()) loop->request_stop();
+}
 
 int run_onboard(const std::string& config_path, double seconds) {
   const char* cmd = "run";
@@ -82,12 +92,25 @@ int run_onboard(const std::string& config_path, double seconds) {
   options.candump_path = (fs::path(config->out) / "bus.log").string();
   options.candump_iface = config->can.interface;
   options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();
+  // Vision and recording on threads of their own: the control loop never waits for them.
+  options.threads = head::VisionThreads::Thread;
+  options.realtime = config->threads;
   auto loop = head::OnboardLoop::create(*model, *camera_model, options, ports);
   if (!loop) return fail(cmd, loop.error());
   (*loop)->set_initial_pose(clock.now_s(), init->front().cam_T_obj);
   const double until = seconds > 0 ? clock.now_s() + seconds : std::numeric_limits<double>::infinity();
+  running_loop.store(loop->get());
+  struct sigaction action{};
+  action.sa_handler = on_stop_signal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
   auto summary = (*loop)->run(until);
+  running_loop.store(nullptr);
   if (!summary) return fail(cmd, summary.error());
+  const std::string summary_path = (fs::path(config->out) / "summary.json").string();
+  std::ofstream summary_file(summary_path);
+  summary_file << summary_json(*summary).dump(1) << '\n';
+  if (!summary_file.flush()) return fail(cmd, "cannot write " + summary_path);
   std::printf("run: %llu ticks (%llu late), %llu frames (%llu tracked, %llu lost), %llu IMU samples, %llu commands\n",
               static_cast<unsigned long long>(summary->ticks), static_cast<unsigned long long>(summary->late_ticks),
               static_cast<unsigned long long>(summary->frames), static_cast<unsigned long long>(summary->tracked),
@@ -99,7 +122,18 @@ int run_onboard(const std::string& config_path, double seconds) {
               summary->track_ms_median, summary->tick_ms_median, static_cast<unsigned long long>(bus_stats.rx_frames),
               static_cast<unsigned long long>(bus_stats.rx_dropped), static_cast<unsigned long long>(bus_stats.tx_failed),
               static_cast<unsigned long long>((*camera)->stats().dropped_frames));
-  std::printf("run: wrote %s and %s\n", options.candump_path.c_str(), options.diagnostics_path.c_str());
+  std::printf("run: control ticks late %.0f us median, %.0f us p99, %.0f us max; %llu of %llu ticks missed (%.3f %%); "
+              "vision latency %.1f ms median, %.1f ms p99; %llu frames dropped while vision was busy; %llu log records "
+              "dropped\n",
+              summary->tick_lateness_us_median, summary->tick_lateness_us_p99, summary->tick_lateness_us_max,
+              static_cast<unsigned long long>(summary->late_ticks), static_cast<unsigned long long>(summary->ticks),
+              summary->ticks ? 100.0 * static_cast<double>(summary->late_ticks) / static_cast<double>(summary->ticks) : 0.0,
+              summary->vision_latency_ms_median, summary->vision_latency_ms_p99,
+              static_cast<unsigned long long>(summary->frames_dropped_vision_busy),
+              static_cast<unsigned long long>(summary->log_frames_dropped + summary->log_lines_dropped));
+  std::printf("run: threads: %s\n", summary->threads.c_str());
+  std::printf("run: wrote %s, %s and %s\n", options.candump_path.c_str(), options.diagnostics_path.c_str(),
+              summary_path.c_str());
   return 0;
 }
 

@@ -77,13 +77,16 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
                   controller.*f.target);
     gains += item;
   }
-  char devices[256];
+  char devices[512];
   std::snprintf(devices, sizeof devices,
                 "    \"camera\": { \"device\": \"%s\", \"width\": %d, \"height\": %d, \"fps\": %g },\n"
                 "    \"can\": { \"interface\": \"%s\" },\n"
-                "    \"head\": { \"pan_backlash_rad\": %g, \"tilt_backlash_rad\": %g },\n",
+                "    \"head\": { \"pan_backlash_rad\": %g, \"tilt_backlash_rad\": %g },\n"
+                "    \"threads\": { \"control_cpu\": %d, \"vision_cpu\": %d, \"control_priority\": %d,\n"
+                "                 \"vision_priority\": %d, \"lock_memory\": %s },\n",
                 d.camera.device.c_str(), d.camera.width, d.camera.height, d.camera.frame_rate_hz, d.can.interface.c_str(),
-                d.backlash.pan_rad, d.backlash.tilt_rad);
+                d.backlash.pan_rad, d.backlash.tilt_rad, d.threads.control_cpu, d.threads.vision_cpu,
+                d.threads.control_priority, d.threads.vision_priority, d.threads.lock_memory ? "true" : "false");
   return "The configuration (JSON; relative paths from its folder; every key but the three files has\n"
          "the default shown):\n"
          "  { \"model\": \"teabox/model.cao\", \"camera_calibration\": \"teabox/camera.yaml\",\n"
@@ -92,7 +95,10 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "\",\n    \"out\": \"" + d.out +
          "\" }\n"
          "fps 0: the driver's current rate. Backlash: the gear's dead band per joint (0: none). The\n"
-         "controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.\n";
+         "controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.\n"
+         "threads: the CPU each thread is pinned to (-1: any) and its SCHED_FIFO priority (1..99; 0: normal\n"
+         "scheduling); lock_memory locks the process in RAM. A refusal (no CAP_SYS_NICE or rtprio limit)\n"
+         "is reported in summary.json and the run goes on with normal scheduling (docs/head.md).\n";
 }
 
 std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
@@ -140,6 +146,31 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
       if (!tilt) return fail(tilt.error());
       c.backlash.pan_rad = *pan;
       c.backlash.tilt_rad = *tilt;
+    }
+    if (j.contains("threads")) {
+      const auto& t = j["threads"];
+      if (!t.is_object()) return fail("threads must be an object");
+      struct IntKey { const char* key; int* target; double lo, hi; };
+      const IntKey keys[] = {{"control_cpu", &c.threads.control_cpu, -1, 1023},
+                             {"vision_cpu", &c.threads.vision_cpu, -1, 1023},
+                             {"control_priority", &c.threads.control_priority, 0, 99},
+                             {"vision_priority", &c.threads.vision_priority, 0, 99}};
+      for (const auto& [key, value] : t.items()) {
+        if (key == "lock_memory") {
+          if (!value.is_boolean()) return fail("threads.lock_memory must be true or false");
+          c.threads.lock_memory = value.get<bool>();
+          continue;
+        }
+        const IntKey* k = nullptr;
+        for (const IntKey& candidate : keys)
+          if (key == candidate.key) k = &candidate;
+        if (!k) return fail("threads." + key + " is not a key of threads (epichead run --help lists them)");
+        const auto v = number(t, "threads", k->key, *k->target, k->lo, k->hi, true);
+        if (!v) return fail(v.error());
+        *k->target = static_cast<int>(*v);
+      }
+      if (c.threads.vision_priority > 0 && c.threads.vision_priority >= c.threads.control_priority)
+        return fail("threads.vision_priority must be below control_priority: vision must never preempt the control loop");
     }
     if (j.contains("controller")) {
       const auto& g = j["controller"];

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "epichead/head/head_controller.h"
+#include "epichead/head/onboard_loop.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
 
@@ -21,6 +22,7 @@ struct RunConfig {
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
   head::JointBacklash backlash;
+  head::RealtimeOptions threads;  // "threads": CPUs and real-time priorities of the control and vision threads
   // The controller's gains the file gives; the others keep HeadControllerOptions' defaults.
   struct {
     std::optional<double> stabilise_gain_per_s, fixate_gain_per_s, fixate_max_rate_radps, target_rate_filter_s,

@@ -1,20 +1,22 @@
 #include "epichead/head/onboard_loop.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <thread>
 #include <variant>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
 #include "epichead/vision/pose_estimator.h"
-#include "epichead/vision/window_image.h"
+#include "realtime.h"
 #include "recent_samples.h"
+#include "recorder.h"
+#include "vision_stage.h"
 
 namespace epichead::head {
 namespace {
@@ -24,20 +26,6 @@ using WallClock = std::chrono::steady_clock;
 
 double wall_ms_since(WallClock::time_point t0) {
   return std::chrono::duration<double, std::milli>(WallClock::now() - t0).count();
-}
-
-// A camera buffer as an 8-bit grey or BGR image: wrapped without a copy, or converted into
-// `scratch` (sized once) for YUYV and RGB. Empty for formats the tracker cannot read (MJPEG).
-cv::Mat as_image(const hw::CameraFrame& f, cv::Mat& scratch) {
-  auto* data = const_cast<std::uint8_t*>(f.data);  // read only: WindowImage::assign copies out
-  const auto stride = static_cast<std::size_t>(f.stride_bytes);
-  switch (f.format) {
-    case hw::PixelFormat::Gray8: return {f.height, f.width, CV_8UC1, data, stride};
-    case hw::PixelFormat::Bgr24: return {f.height, f.width, CV_8UC3, data, stride};
-    case hw::PixelFormat::Rgb24: cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC3, data, stride), scratch, cv::COLOR_RGB2BGR); return scratch;
-    case hw::PixelFormat::Yuyv: cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC2, data, stride), scratch, cv::COLOR_YUV2BGR_YUYV); return scratch;
-    default: return {};
-  }
 }
 
 // The centre of the model's vertices: what fixation keeps in the middle of the image.
@@ -51,39 +39,29 @@ Eigen::Vector3d model_centre(const vision::CadModel& model) {
 
 struct OnboardLoop::Impl {
   Impl(const vision::CadModel& m, const vision::Camera& cam, const OnboardOptions& o, const OnboardPorts& p,
-       fusion::Predictor pred, HeadController ctrl)
-      : model(&m), camera(cam), options(o), ports(p), tracker(m, cam, o.tracker), predictor(std::move(pred)),
-        controller(std::move(ctrl)), target_point_obj(model_centre(m)) {}
+       fusion::Predictor pred, HeadController ctrl, std::unique_ptr<Recorder> rec)
+      : model(&m), camera(cam), options(o), ports(p),
+        vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
+        controller(std::move(ctrl)), target_point_obj(model_centre(m)), recorder(std::move(rec)) {}
 
   const vision::CadModel* model;
   vision::Camera camera;
   OnboardOptions options;
   OnboardPorts ports;
-  vision::ModelTracker tracker;
+  VisionStage vision;
   fusion::Predictor predictor;
   HeadController controller;
   Eigen::Vector3d target_point_obj;
   DeviceClockSync imu_clock;
   ImuFrameAssembler assembler;
-  std::optional<fw::CandumpWriter> log;
-  std::FILE* diagnostics = nullptr;
-  vision::WindowImage image;
-  cv::Mat converted;  // YUYV / RGB frames converted to BGR (reused)
-  vision::FrameReport report;
+  std::unique_ptr<Recorder> recorder;
+  std::atomic<bool> stop_requested{false};
 
   // Initial pose and the last good one: where windows go while the predictor has nothing.
   Eigen::Isometry3d last_good = Eigen::Isometry3d::Identity();
   double init_t_s = 0;
   bool init_pending = false;
 
-  // A vision result waiting for its publication time (modelled processing).
-  struct Pending {
-    bool active = false;
-    double publish_t_s = 0, exposure_t_s = 0, taken_t_s = 0;
-    Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
-    Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
-    vision::TrackStatus status = vision::TrackStatus::Lost;
-  } pending;
   std::optional<double> target_exposure_t_s;  // exposure time of the target given to the controller, until a command uses it
   double target_publish_t_s = 0;              // when that target was published (the processing done)
 
@@ -96,12 +74,13 @@ struct OnboardLoop::Impl {
   OnboardSummary summary;
   // The last minutes of each timing, for the summary's percentiles.
   RecentSamples track_ms{1 << 14}, tick_ms{1 << 18}, latency_ms{1 << 14}, frame_age_ms{1 << 14}, overhead_ms{1 << 14};
+  RecentSamples lateness_us{1 << 18}, vision_latency_ms{1 << 14};
+  double lateness_us_max = 0, tick_work_us_max = 0, vision_latency_ms_max = 0;  // over the whole run
+  std::uint64_t frame_index = 0;
   double next_sync_s = 0, next_diag_s = 0;
   std::uint64_t heartbeats = 0;
 
-  void record(const fw::StampedCanFrame& f, fw::CanDirection dir) {
-    if (log && log->write(f, options.candump_iface, dir)) ++summary.frames_logged;
-  }
+  void record(const fw::StampedCanFrame& f, fw::CanDirection dir) { recorder->frame(f, dir); }
   void send(const fw::CanFrame& frame, double now_s) {
     if (auto ok = ports.bus->send(frame); !ok) {
       ++summary.send_failures;
@@ -153,50 +132,67 @@ struct OnboardLoop::Impl {
     if (std::isfinite(s.gyro_radps.sum())) gyro = GyroReading{s.t_s, s.gyro_radps};
   }
 
-  void take_frame(double now_s, const FrameHook& hook) {
-    if (pending.active) return;  // one frame in processing at a time (the camera queues the rest)
+  // A new camera frame, if one is ready: to the vision stage with the pose predicted at its
+  // exposure, or dropped (counted) while the stage is busy with an earlier one.
+  // Returns whether a job was submitted.
+  bool take_frame(double now_s) {
     hw::CameraFrame frame;
     const hw::CameraRead r = ports.camera->next_frame(frame, 0);
     if (r == hw::CameraRead::Lost) ++summary.camera_lost;
-    if (r != hw::CameraRead::Frame) return;
-    const cv::Mat mat = as_image(frame, converted);
-    if (mat.empty() || !image.assign(mat)) {
-      ++summary.unreadable_frames;
-      return;
+    if (r != hw::CameraRead::Frame) return false;
+    if (vision.busy()) {
+      ++summary.frames_dropped_vision_busy;
+      return false;
     }
     const double exposure = frame.t_s;
     if (init_pending) {
       const auto v = predictor.add_vision(init_t_s, last_good, vision::initial_pose_covariance()).verdict;
       init_pending = v != fusion::VisionVerdict::Initialised && v != fusion::VisionVerdict::Applied;
     }
+    VisionJob& job = vision.prepare(frame);
     const auto prediction = predictor.predict(exposure);
-    const Eigen::Isometry3d predicted = prediction ? prediction->cam_T_obj : last_good;
-    const auto t0 = WallClock::now();
-    tracker.track(image, predicted, report);
-    const double ms = wall_ms_since(t0);
-    track_ms.push(ms);
-    ++summary.frames;
-    (report.status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
+    job.index = frame_index++;
+    job.exposure_t_s = exposure;
+    job.taken_t_s = now_s;
+    job.predicted = prediction ? prediction->cam_T_obj : last_good;
     frame_age_ms.push(1e3 * (now_s - exposure));
-    pending = {true, options.processing_s >= 0 ? now_s + options.processing_s : ports.clock->now_s(), exposure, now_s,
-               report.cam_T_obj, report.covariance, report.status};
-    if (hook) hook({summary.frames - 1, exposure, pending.publish_t_s, predicted, &report, &tracker, &frame});
+    vision.submit(now_s);
+    return true;
   }
 
-  void publish(double now_s) {
-    if (!pending.active || now_s < pending.publish_t_s) return;
-    pending.active = false;
-    last_status = pending.status;
-    if (pending.status == vision::TrackStatus::Lost) return;  // the controller's watchdog sees the target go stale
-    last_good = pending.cam_T_obj;
-    predictor.add_vision(pending.exposure_t_s, pending.cam_T_obj, vision::kTrackedPoseCovarianceInflation * pending.covariance);
-    target = target_from_pose(pending.exposure_t_s, pending.cam_T_obj, target_point_obj);
-    target_exposure_t_s = pending.exposure_t_s;
-    target_publish_t_s = pending.publish_t_s;
+  // The vision stage's result once it is published: the predictor's late update and the
+  // controller's target.
+  void publish(double now_s, const FrameHook& hook) {
+    const VisionResult* r = vision.poll(now_s);
+    if (!r) return;
+    if (!r->readable) {
+      ++summary.unreadable_frames;
+      vision.release();
+      return;
+    }
+    const vision::FrameReport& report = *r->report;
+    track_ms.push(r->track_ms);
+    ++summary.frames;
+    (report.status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
+    // Inline: at the modelled time the stage set; Thread: now, when the control thread takes it.
+    const double published = options.threads == VisionThreads::Inline ? r->done_t_s : now_s;
+    const double latency_ms = 1e3 * (published - r->exposure_t_s);
+    vision_latency_ms.push(latency_ms);
+    vision_latency_ms_max = std::max(vision_latency_ms_max, latency_ms);
+    if (hook) hook({summary.frames - 1, r->exposure_t_s, published, r->predicted, &report, r->tracker, r->image});
+    last_status = report.status;
+    if (report.status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
+      last_good = report.cam_T_obj;
+      predictor.add_vision(r->exposure_t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
+      target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
+      target_exposure_t_s = r->exposure_t_s;
+      target_publish_t_s = published;
+    }
+    vision.release();
   }
 
   void diagnose(double now_s, const ControlOutput& out) {
-    if (!diagnostics) return;
+    if (options.diagnostics_path.empty()) return;
     for (int i = 0; i < out.event_count; ++i) {
       const HeadEvent& e = out.events[static_cast<std::size_t>(i)];
       nlohmann::json j{{"t_s", e.t_s}, {"event", to_string(e.kind)}};
@@ -207,7 +203,7 @@ struct OnboardLoop::Impl {
       } else if (e.kind != EventKind::Parked) {
         j["fault"] = to_string(e.fault);
       }
-      std::fprintf(diagnostics, "%s\n", j.dump().c_str());
+      recorder->line(j.dump());
     }
     if (now_s < next_diag_s) return;
     next_diag_s = now_s + options.diagnostics_period_s;
@@ -223,8 +219,11 @@ struct OnboardLoop::Impl {
                            {"commands_sent", summary.commands_sent},
                            {"bus_state", hw::to_string(bus_state)},
                            {"target_error_deg", std::isfinite(out.target_error_rad) ? out.target_error_rad * 180 / M_PI : -1.0},
-                           {"clock_round_trip_ms", imu_clock.round_trip_s() * 1e3}};
-    std::fprintf(diagnostics, "%s\n", j.dump().c_str());
+                           {"clock_round_trip_ms", imu_clock.round_trip_s() * 1e3},
+                           {"frames_dropped_vision_busy", summary.frames_dropped_vision_busy},
+                           {"late_ticks", summary.late_ticks},
+                           {"tick_lateness_us_max", lateness_us_max}};
+    recorder->line(j.dump());
   }
 
   void tick(double now_s, const FrameHook& hook) {
@@ -234,9 +233,10 @@ struct OnboardLoop::Impl {
       if (auto frame = fw::encode(imu_clock.make_request(now_s))) send(frame->frame, now_s);
     }
     drain_bus(now_s);
-    publish(now_s);
-    take_frame(now_s, hook);
-    publish(now_s);  // processing_s == 0 publishes at once
+    publish(now_s, hook);
+    const bool submitted = take_frame(now_s);
+    const double inline_vision_ms = submitted && options.threads == VisionThreads::Inline ? vision.inline_wall_ms() : 0;
+    publish(now_s, hook);  // Inline with processing_s == 0 publishes at once
     ControlInput in;
     in.t_s = now_s;
     in.gyro = gyro;
@@ -258,14 +258,15 @@ struct OnboardLoop::Impl {
       ++summary.commands_withheld;
     }
     diagnose(now_s, out);
-    tick_ms.push(wall_ms_since(t0));
+    // The tick's own work: inline tracking is the vision stage's time, not the control loop's.
+    const double work_ms = std::max(0.0, wall_ms_since(t0) - inline_vision_ms);
+    tick_ms.push(work_ms);
+    tick_work_us_max = std::max(tick_work_us_max, 1e3 * work_ms);
   }
 };
 
 OnboardLoop::OnboardLoop(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-OnboardLoop::~OnboardLoop() {
-  if (impl_ && impl_->diagnostics) std::fclose(impl_->diagnostics);
-}
+OnboardLoop::~OnboardLoop() = default;
 
 std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(const vision::CadModel& model,
                                                                               const vision::Camera& camera,
@@ -282,18 +283,18 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
   auto controller = HeadController::create(options.controller);
   if (!controller) return std::unexpected("onboard loop: head controller: " + controller.error());
   controller->request(options.mode);
-  auto impl = std::make_unique<Impl>(model, camera, options, ports, std::move(*predictor), std::move(*controller));
-  if (!options.candump_path.empty()) {
-    auto log = fw::CandumpWriter::open(options.candump_path);
-    if (!log) return std::unexpected("onboard loop: " + log.error());
-    impl->log.emplace(std::move(*log));
-  }
-  if (!options.diagnostics_path.empty()) {
-    impl->diagnostics = std::fopen(options.diagnostics_path.c_str(), "w");
-    if (!impl->diagnostics) return std::unexpected("onboard loop: cannot write " + options.diagnostics_path);
-  }
+  if (options.candump_iface.empty() || options.candump_iface.size() > fw::kCandumpMaxIface ||
+      options.candump_iface.find_first_of(" \t\r\n") != std::string::npos)
+    return std::unexpected("onboard loop: CAN interface name '" + options.candump_iface + "' cannot be recorded");
+  auto recorder = Recorder::open(options.candump_path, options.candump_iface, options.diagnostics_path,
+                                 options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline);
+  if (!recorder) return std::unexpected("onboard loop: " + recorder.error());
+  auto impl = std::make_unique<Impl>(model, camera, options, ports, std::move(*predictor), std::move(*controller),
+                                     std::move(*recorder));
   return std::unique_ptr<OnboardLoop>(new OnboardLoop(std::move(impl)));
 }
+
+void OnboardLoop::request_stop() { impl_->stop_requested.store(true, std::memory_order_relaxed); }
 
 void OnboardLoop::set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_obj) {
   impl_->last_good = cam_T_obj;
@@ -304,27 +305,65 @@ void OnboardLoop::set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_ob
 std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, const FrameHook& hook) {
   Impl& s = *impl_;
   if (auto ok = s.ports.camera->start(); !ok) return std::unexpected("camera: " + ok.error());
+  const RealtimeOptions& rt = s.options.realtime;
+  if (s.options.threads == VisionThreads::Thread) {
+    const std::string memory = rt.lock_memory ? lock_memory() + "; " : "";
+    s.summary.threads = memory + "control: " + pin_current_thread(rt.control_cpu) + ", " + request_fifo(rt.control_priority);
+    std::atomic<bool> vision_ready{false};
+    std::string vision_note;
+    s.vision.start([&] {
+      vision_note = "; vision: " + pin_current_thread(rt.vision_cpu) + ", " + request_fifo(rt.vision_priority);
+      vision_ready.store(true, std::memory_order_release);
+    });
+    while (!vision_ready.load(std::memory_order_acquire)) std::this_thread::yield();
+    s.summary.threads += vision_note;
+  } else {
+    s.summary.threads = "inline: vision and recording on the control thread (simulated time)";
+  }
   const double period = 1.0 / s.options.control_rate_hz;
   double next = s.ports.clock->now_s();
-  while (next <= until_s) {
-    if (auto ok = s.ports.wait_until(next); !ok) return std::unexpected(ok.error());
+  std::expected<void, std::string> failed;
+  while (next <= until_s && !s.stop_requested.load(std::memory_order_relaxed)) {
+    if (auto ok = s.ports.wait_until(next); !ok) {
+      failed = std::unexpected(ok.error());
+      break;
+    }
     const double now = s.ports.clock->now_s();
+    const double late_us = std::max(0.0, 1e6 * (now - next));
+    s.lateness_us.push(late_us);
+    s.lateness_us_max = std::max(s.lateness_us_max, late_us);
     if (now - next > period) ++s.summary.late_ticks;
     s.tick(now, hook);
     ++s.summary.ticks;
     next += period;
     if (next < now) next = now;  // a late loop does not try to catch up tick by tick
   }
+  s.vision.stop();
   s.ports.camera->stop();
-  if (s.log) {
-    if (auto ok = s.log->close(); !ok) return std::unexpected(ok.error());
-  }
-  if (s.diagnostics) std::fflush(s.diagnostics);
+  const RecorderCounters rc = s.recorder->counters();
+  auto closed = s.recorder->close();
+  if (!failed) return std::unexpected(failed.error());
+  if (!closed) return std::unexpected(closed.error());
   OnboardSummary out = s.summary;
+  out.frames_logged = rc.frames_logged;
+  out.log_frames_dropped = rc.frames_dropped;
+  out.log_lines_dropped = rc.lines_dropped;
+  out.log_write_errors = rc.write_errors;
+  out.log_frame_queue_high_water = rc.frame_queue_high_water;
+  out.log_line_queue_high_water = rc.line_queue_high_water;
   out.track_ms_median = s.track_ms.percentile(0.5);
   out.track_ms_p99 = s.track_ms.percentile(0.99);
   out.tick_ms_median = s.tick_ms.percentile(0.5);
   out.tick_ms_p99 = s.tick_ms.percentile(0.99);
+  out.tick_work_us_median = 1e3 * out.tick_ms_median;
+  out.tick_work_us_p99 = 1e3 * out.tick_ms_p99;
+  out.tick_work_us_max = s.tick_work_us_max;
+  out.tick_lateness_us_median = s.lateness_us.percentile(0.5);
+  out.tick_lateness_us_p99 = s.lateness_us.percentile(0.99);
+  out.tick_lateness_us_max = s.lateness_us_max;
+  out.vision_latency_ms_median = s.vision_latency_ms.percentile(0.5);
+  out.vision_latency_ms_p99 = s.vision_latency_ms.percentile(0.99);
+  out.vision_latency_ms_max = s.vision_latency_ms_max;
   out.exposure_to_command_ms_median = s.latency_ms.percentile(0.5);
   out.exposure_to_command_ms_max = s.latency_ms.max();
   out.frame_age_at_take_ms_median = s.frame_age_ms.percentile(0.5);

@@ -25,6 +25,19 @@ frames=$(field 'frames'); imu=$(field 'IMU samples'); commands=$(field 'commands
 [ -n "$imu" ] && [ "$imu" -gt 0 ] || bad "no IMU samples reached the loop ($summary)"
 [ -n "$commands" ] && [ "$commands" -gt 0 ] || bad "the loop sent no head commands ($summary)"
 
+# The deadlines, measured on the control thread (issue 22): printed, and the missed ticks checked.
+summary_json=/tmp/run-out/summary.json
+if [ -s "$summary_json" ]; then
+  jq -c '{ticks, late_ticks, frames, deadlines}' "$summary_json"
+  if jq -e '.frames > 0 and .deadlines.ticks_missed_fraction <= 0.001' "$summary_json" >/dev/null; then
+    echo "onboard: ok   control ticks missed <= 0.1 % while vision ran"
+  else
+    bad "control ticks missed > 0.1 % (or no frame tracked): $(jq -c '.deadlines | {ticks_missed, ticks_missed_fraction}' "$summary_json")"
+  fi
+else
+  bad "no $summary_json"
+fi
+
 log=/tmp/run-out/bus.log
 [ -s "$log" ] || { bad "no candump log at $log"; exit 1; }
 echo "onboard: $(wc -l <"$log") lines in $log, first: $(head -1 "$log")"

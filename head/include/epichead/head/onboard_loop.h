@@ -8,9 +8,12 @@
 // diagnostics period (and per controller event) goes to the diagnostics stream.
 //
 // The same code runs on the robot (Linux drivers, wall-clock waits) and in the closed-loop
-// simulator (simulated ports, waits that advance simulated time). Vision runs inline; its result
-// is published `processing_s` after the frame was taken from the camera when that is set (the
-// simulator's modelled processing time, so runs are deterministic), else when it is done.
+// simulator (simulated ports, waits that advance simulated time), in two stages: the control
+// thread above, and the vision stage, which tracks one frame at a time and hands its result
+// back without the control thread ever waiting for it (head/src/vision_stage.h). On the robot
+// (VisionThreads::Thread) vision and recording run on threads of their own; in the simulator
+// (VisionThreads::Inline) the control thread tracks the frame when it takes it and publishes the
+// result `processing_s` later in simulated time, so that the same seed gives the same run.
 #include <cstdint>
 #include <cstdio>
 #include <expected>
@@ -41,11 +44,25 @@ struct OnboardPorts {
   std::function<std::expected<void, std::string>(double t_s)> wait_until;
 };
 
+// How the vision stage and the recorder run: Inline (deterministic, the simulator) or on threads of
+// their own (the robot; `sim-run --threads wall`).
+enum class VisionThreads { Inline, Thread };
+
+// Scheduling of the threads (Thread mode): see realtime.h for what happens when it is refused.
+struct RealtimeOptions {
+  int control_cpu = -1, vision_cpu = -1;  // pin to this CPU (-1: leave to the scheduler)
+  int control_priority = 0;               // SCHED_FIFO priority 1..99 of the control thread (0: normal)
+  int vision_priority = 0;                // the same for the vision worker (below the control thread's)
+  bool lock_memory = false;               // mlockall: no page faults on the control thread after start-up
+};
+
 struct OnboardOptions {
   double control_rate_hz = 1000;
   double time_sync_period_s = 0.1;
   double diagnostics_period_s = 0.1;
-  double processing_s = -1;            // >= 0: vision results are published this long after the frame arrived
+  VisionThreads threads = VisionThreads::Inline;
+  RealtimeOptions realtime;
+  double processing_s = -1;            // Inline, >= 0: vision results are published this long after the frame arrived
   ControlMode mode = ControlMode::Fixate;
   vision::ModelTrackerOptions tracker;
   fusion::PredictorOptions predictor;  // the IMU is mapped to the controller clock here: its offset is unused
@@ -55,7 +72,8 @@ struct OnboardOptions {
   std::string diagnostics_path;        // JSON lines; empty: none
 };
 
-// One tracked frame, given to the caller's hook (overlays, ground-truth comparison).
+// One tracked frame, given to the caller's hook (overlays, ground-truth comparison) on the control
+// thread when the result is published.
 struct TrackedFrame {
   std::uint64_t index = 0;
   double exposure_t_s = 0, published_t_s = 0;
@@ -80,7 +98,19 @@ struct OnboardSummary {
   double exposure_to_command_ms_median = 0, exposure_to_command_ms_max = 0;
   double frame_age_at_take_ms_median = 0;
   double result_to_command_ms_max = 0;
-  double tick_ms_median = 0, tick_ms_p99 = 0;                   // wall time of one control tick's work
+  double tick_ms_median = 0, tick_ms_p99 = 0;                   // wall time of one control tick's work (vision excluded)
+  // Deadlines, measured on the control thread alone: how late each tick started after its
+  // scheduled time (loop clock: 0 in simulated time), the tick's own work (wall clock, without
+  // inline vision), vision latency from exposure to the published result (loop clock), frames
+  // the camera gave while vision was busy (dropped: the next job is the newest frame).
+  double tick_lateness_us_median = 0, tick_lateness_us_p99 = 0, tick_lateness_us_max = 0;
+  double tick_work_us_median = 0, tick_work_us_p99 = 0, tick_work_us_max = 0;
+  double vision_latency_ms_median = 0, vision_latency_ms_p99 = 0, vision_latency_ms_max = 0;
+  std::uint64_t frames_dropped_vision_busy = 0;
+  // Recording (candump, diagnostics) through the recorder's queues: dropped when full, never waited for.
+  std::uint64_t log_frames_dropped = 0, log_lines_dropped = 0, log_write_errors = 0;
+  std::size_t log_frame_queue_high_water = 0, log_line_queue_high_water = 0;
+  std::string threads;  // what each thread got: CPU, scheduling policy, memory lock
   HeadCounters controller;
   ImuAssemblyCounters imu_assembly;
   fusion::PredictorCounters predictor;
@@ -97,6 +127,8 @@ class OnboardLoop {
   std::expected<OnboardSummary, std::string> run(double until_s, const FrameHook& hook = {});
   // The pose tracking starts from (init.csv on the robot, the scenario's start in the simulator).
   void set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_obj);
+  // Ends run() after the current tick; safe from a signal handler or another thread.
+  void request_stop();
 
  private:
   struct Impl;

@@ -1,0 +1,111 @@
+#include "vision_stage.h"
+
+#include <chrono>
+#include <cstring>
+
+#include <opencv2/imgproc.hpp>
+
+namespace epichead::head {
+
+cv::Mat as_image(const hw::CameraFrame& f, cv::Mat& scratch) {
+  auto* data = const_cast<std::uint8_t*>(f.data);  // read only: WindowImage::assign copies out
+  const auto stride = static_cast<std::size_t>(f.stride_bytes);
+  switch (f.format) {
+    case hw::PixelFormat::Gray8: return {f.height, f.width, CV_8UC1, data, stride};
+    case hw::PixelFormat::Bgr24: return {f.height, f.width, CV_8UC3, data, stride};
+    case hw::PixelFormat::Rgb24: cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC3, data, stride), scratch, cv::COLOR_RGB2BGR); return scratch;
+    case hw::PixelFormat::Yuyv: cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC2, data, stride), scratch, cv::COLOR_YUV2BGR_YUYV); return scratch;
+    default: return {};
+  }
+}
+
+VisionStage::VisionStage(const vision::CadModel& model, const vision::Camera& camera,
+                         const vision::ModelTrackerOptions& options, VisionThreads threads, double processing_s,
+                         const hw::Clock& clock)
+    : tracker_(model, camera, options), threads_(threads), processing_s_(processing_s), clock_(clock) {}
+
+VisionStage::~VisionStage() { stop(); }
+
+void VisionStage::start(const std::function<void()>& on_start) {
+  if (threads_ != VisionThreads::Thread || worker_.joinable()) return;
+  stop_.store(false, std::memory_order_relaxed);
+  worker_ = std::thread([this, on_start] {
+    if (on_start) on_start();
+    worker_loop();
+  });
+}
+
+void VisionStage::stop() {
+  if (!worker_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  submitted_.fetch_add(1, std::memory_order_release);  // wait() returns only on a change of value
+  submitted_.notify_one();
+  worker_.join();
+}
+
+VisionJob& VisionStage::prepare(const hw::CameraFrame& frame) {
+  const std::size_t n = frame.size_bytes;
+  if (bytes_.size() < n) bytes_.resize(n);  // the first frame (or a larger one): once
+  if (n > 0) std::memcpy(bytes_.data(), frame.data, n);
+  job_.frame = frame;
+  job_.frame.data = bytes_.data();
+  return job_;
+}
+
+void VisionStage::track_job() {
+  result_.index = job_.index;
+  result_.exposure_t_s = job_.exposure_t_s;
+  result_.taken_t_s = job_.taken_t_s;
+  result_.predicted = job_.predicted;
+  result_.report = &report_;
+  result_.tracker = &tracker_;
+  result_.image = &job_.frame;
+  const cv::Mat mat = as_image(job_.frame, converted_);
+  result_.readable = !mat.empty() && image_.assign(mat).has_value();
+  result_.track_ms = 0;
+  if (result_.readable) {
+    const auto t0 = std::chrono::steady_clock::now();
+    tracker_.track(image_, job_.predicted, report_);
+    result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+}
+
+void VisionStage::submit(double now_s) {
+  busy_ = true;
+  if (threads_ == VisionThreads::Thread) {
+    submitted_.fetch_add(1, std::memory_order_release);  // publishes job_ to the worker
+    submitted_.notify_one();
+    return;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  track_job();
+  inline_wall_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  publish_t_s_ = processing_s_ >= 0 ? now_s + processing_s_ : clock_.now_s();
+  result_.done_t_s = publish_t_s_;
+}
+
+const VisionResult* VisionStage::poll(double now_s) {
+  if (!busy_) return nullptr;
+  if (threads_ == VisionThreads::Thread)
+    return done_.load(std::memory_order_acquire) == submitted_.load(std::memory_order_relaxed) ? &result_ : nullptr;
+  return now_s >= publish_t_s_ ? &result_ : nullptr;
+}
+
+void VisionStage::release() { busy_ = false; }
+
+void VisionStage::worker_loop() {
+  std::uint64_t seen = 0;
+  for (;;) {
+    // Sleeps in the kernel (a futex) until a job is posted or stop is asked.
+    submitted_.wait(seen, std::memory_order_acquire);
+    if (stop_.load(std::memory_order_acquire)) return;
+    const std::uint64_t posted = submitted_.load(std::memory_order_acquire);
+    if (posted == seen) continue;
+    seen = posted;
+    track_job();
+    result_.done_t_s = 0;  // the loop's clock belongs to the control thread: it stamps the publication
+    done_.store(seen, std::memory_order_release);  // publishes result_ to the control thread
+  }
+}
+
+}  // namespace epichead::head
