@@ -1,261 +1,25 @@
-// The built-in scenes: geometry (model and render meshes), appearance, environment, light.
+// The built-in scenes: render meshes, appearance, environment, light (their tracked objects'
+// models: scene_models.cpp).
 #include "epichead/sim/scene_library.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
 #include <opencv2/imgproc.hpp>
 
 #include "epichead/sim/builtin_asset.h"
+#include "scene_dressing.h"
 #include "scene_photo.h"
+#include "scene_shapes.h"
 #include "texture.h"
 
 namespace epichead::sim {
 namespace {
 
 using Eigen::Vector3d;
-using vision::RawModel;
-
-// ---- model building -------------------------------------------------------------------------
-
-// An axis-aligned box as 8 points and 6 faces (CCW from outside). Returns its first face index.
-int add_box_model(RawModel& raw, const Vector3d& lo, const Vector3d& hi) {
-  const int first = static_cast<int>(raw.vertices.size());
-  for (int i = 0; i < 8; ++i)
-    raw.vertices.emplace_back((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
-  auto v = [&](int sx, int sy, int sz) { return first + (sx ? 1 : 0) + (sy ? 2 : 0) + (sz ? 4 : 0); };
-  const int face = static_cast<int>(raw.face_loops.size());
-  raw.face_loops.push_back({v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)});  // +x
-  raw.face_loops.push_back({v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)});  // -x
-  raw.face_loops.push_back({v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)});  // +y
-  raw.face_loops.push_back({v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)});  // -y
-  raw.face_loops.push_back({v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)});  // +z
-  raw.face_loops.push_back({v(0, 1, 0), v(1, 1, 0), v(1, 0, 0), v(0, 0, 0)});  // -z
-  return face;
-}
-
-int add_quad_model(RawModel& raw, const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& d) {
-  const int first = static_cast<int>(raw.vertices.size());
-  raw.vertices.insert(raw.vertices.end(), {a, b, c, d});
-  raw.face_loops.push_back({first, first + 1, first + 2, first + 3});
-  return static_cast<int>(raw.face_loops.size()) - 1;
-}
-
-// Lamp shade geometry (object frame: bottom rim centre at the origin, axis +z).
-constexpr double kShadeBottomRadius = 0.12, kShadeTopRadius = 0.07, kShadeHeight = 0.16;
-constexpr int kShadeFacets = 36;
-
-// Can (object frame: bottom centre at the origin, axis +z): a cylinder modelled, as ViSP users do,
-// by its facets and its two rim circles; rendered smooth.
-constexpr double kCanRadius = 0.04, kCanHeight = 0.12;
-constexpr int kCanFacets = 32;
-
-// Bowl (object frame: bottom centre at the origin, axis +z): the profile's slope angle grows
-// linearly along its arc length s, so r(s) and z(s) are closed-form and the render can sample the
-// same curve finely. The model's rings are points of that curve; facets of neighbouring rings
-// differ by (end - start) / rings = 12 deg, below the 20 deg crease angle, so ring edges are not
-// tracked (no image edge there), only the rim circle and the silhouette.
-constexpr double kBowlFootRadius = 0.05, kBowlProfileLength = 0.10;
-constexpr double kBowlStartSlopeRad = 40.0 * std::numbers::pi / 180, kBowlEndSlopeRad = 88.0 * std::numbers::pi / 180;
-constexpr int kBowlRings = 4, kBowlFacets = 32;
-// (radius, height) of the bowl profile at fraction u (0 = foot, 1 = rim) of its arc length.
-Eigen::Vector2d bowl_profile(double u) {
-  const double k = (kBowlEndSlopeRad - kBowlStartSlopeRad) / kBowlProfileLength;
-  const double theta = kBowlStartSlopeRad + u * (kBowlEndSlopeRad - kBowlStartSlopeRad);
-  return {kBowlFootRadius + (std::sin(theta) - std::sin(kBowlStartSlopeRad)) / k,
-          (std::cos(kBowlStartSlopeRad) - std::cos(theta)) / k};
-}
-
-// Rings of `facets` vertices at the given (radius, height) profile points and the quads between
-// consecutive rings (CCW from outside): a body of revolution about z as ViSP users model one.
-void add_revolution_model(RawModel& raw, const std::vector<Eigen::Vector2d>& profile, int facets) {
-  const int first = static_cast<int>(raw.vertices.size());
-  for (const Eigen::Vector2d& rz : profile)
-    for (int i = 0; i < facets; ++i) {
-      const double a = 2 * std::numbers::pi * i / facets;
-      raw.vertices.emplace_back(rz.x() * std::cos(a), rz.x() * std::sin(a), rz.y());
-    }
-  for (std::size_t ring = 0; ring + 1 < profile.size(); ++ring)
-    for (int i = 0; i < facets; ++i) {
-      const int lo = first + static_cast<int>(ring) * facets, hi = lo + facets;
-      const int j = (i + 1) % facets;
-      raw.face_loops.push_back({lo + i, lo + j, hi + j, hi + i});
-    }
-}
-
-// Box of box_clutter: 0.20 x 0.15 x 0.10 m standing on the table, bottom centre at the origin.
-const Vector3d kPackageLo(-0.10, -0.075, 0.0), kPackageHi(0.10, 0.075, 0.10);
-
-// mockup_walk parts (object frame: floor at z = 0, viewer on the -y side).
-struct MockupPart { const char* name; Vector3d lo, hi; double reflectance; };
-const MockupPart kMockupParts[] = {
-    {"bulkhead", {-0.50, 0.20, 0.00}, {0.50, 0.22, 0.80}, 0.55},
-    {"deck", {-0.50, -0.30, 0.00}, {0.50, 0.20, 0.02}, 0.62},
-    {"t_web", {0.195, 0.00, 0.02}, {0.205, 0.20, 0.80}, 0.58},
-    {"t_flange", {0.14, -0.012, 0.02}, {0.26, 0.00, 0.80}, 0.60},
-    {"bulkhead_stiffener", {-0.50, 0.12, 0.49}, {0.195, 0.20, 0.50}, 0.58},
-    {"flat_bar_front", {-0.45, -0.260, 0.02}, {0.45, -0.252, 0.06}, 0.60},
-    {"flat_bar_middle", {-0.45, -0.230, 0.02}, {0.45, -0.222, 0.06}, 0.60},
-    {"flat_bar_back", {-0.45, -0.200, 0.02}, {0.45, -0.192, 0.06}, 0.60},
-};
-
-// office_pan: the room corner at the origin, back wall in the plane y = 0, left wall x = 0.
-constexpr double kRoomX = 4.0, kRoomY = 5.0, kRoomH = 2.5;
-struct OfficeBox { Vector3d lo, hi; int material; };  // materials: 3 frame, 4 desk top, 5 desk legs
-const OfficeBox kOfficeBoxes[] = {
-    {{2.13, -0.02, 0.0}, {2.20, 0.0, 2.12}, 3},   // door frame: left jamb
-    {{3.10, -0.02, 0.0}, {3.17, 0.0, 2.12}, 3},   // right jamb
-    {{2.20, -0.02, 2.05}, {3.10, 0.0, 2.12}, 3},  // head
-    {{0.30, -0.75, 0.72}, {1.50, -0.05, 0.75}, 4},  // desk top
-    {{0.33, -0.72, 0.0}, {0.37, -0.68, 0.72}, 5},  // legs
-    {{1.43, -0.72, 0.0}, {1.47, -0.68, 0.72}, 5},
-    {{0.33, -0.12, 0.0}, {0.37, -0.08, 0.72}, 5},
-    {{1.43, -0.12, 0.0}, {1.47, -0.08, 0.72}, 5},
-};
-
-std::expected<vision::CadModel, std::string> model_of(std::string_view name) {
-  RawModel raw;
-  if (name == "mockup_walk") {
-    for (const auto& p : kMockupParts) add_box_model(raw, p.lo, p.hi);
-  } else if (name == "lampshade") {
-    for (int ring = 0; ring < 2; ++ring)
-      for (int i = 0; i < kShadeFacets; ++i) {
-        const double a = 2 * std::numbers::pi * i / kShadeFacets;
-        const double r = ring == 0 ? kShadeBottomRadius : kShadeTopRadius;
-        raw.vertices.emplace_back(r * std::cos(a), r * std::sin(a), ring == 0 ? 0.0 : kShadeHeight);
-      }
-    for (int i = 0; i < kShadeFacets; ++i) {
-      const int j = (i + 1) % kShadeFacets;
-      raw.face_loops.push_back({i, j, kShadeFacets + j, kShadeFacets + i});
-    }
-    // The rims, each facing out of its opening.
-    raw.circles.push_back({Vector3d::Zero(), -Vector3d::UnitZ(), kShadeBottomRadius});
-    raw.circles.push_back({Vector3d(0, 0, kShadeHeight), Vector3d::UnitZ(), kShadeTopRadius});
-  } else if (name == "box_clutter") {
-    add_box_model(raw, kPackageLo, kPackageHi);
-  } else if (name == "can") {
-    add_revolution_model(raw, {{kCanRadius, 0.0}, {kCanRadius, kCanHeight}}, kCanFacets);
-    raw.circles.push_back({Vector3d::Zero(), -Vector3d::UnitZ(), kCanRadius});
-    raw.circles.push_back({Vector3d(0, 0, kCanHeight), Vector3d::UnitZ(), kCanRadius});
-  } else if (name == "bowl") {
-    std::vector<Eigen::Vector2d> profile;
-    for (int ring = 0; ring <= kBowlRings; ++ring) profile.push_back(bowl_profile(static_cast<double>(ring) / kBowlRings));
-    add_revolution_model(raw, profile, kBowlFacets);
-    // The open top: its rim, facing out of the opening.
-    raw.circles.push_back({Vector3d(0, 0, profile.back().y()), Vector3d::UnitZ(), profile.back().x()});
-  } else if (name == "office_pan") {
-    add_quad_model(raw, {0, 0, 0}, {0, -kRoomY, 0}, {kRoomX, -kRoomY, 0}, {kRoomX, 0, 0});       // floor
-    add_quad_model(raw, {0, 0, 0}, {kRoomX, 0, 0}, {kRoomX, 0, kRoomH}, {0, 0, kRoomH});         // back wall
-    add_quad_model(raw, {0, -kRoomY, 0}, {0, 0, 0}, {0, 0, kRoomH}, {0, -kRoomY, kRoomH});       // left wall
-    for (const auto& b : kOfficeBoxes) add_box_model(raw, b.lo, b.hi);
-  } else {
-    std::string known;
-    for (const auto& n : scene_names()) {
-      if (!known.empty()) known += ", ";
-      known += n;
-    }
-    return std::unexpected("unknown scene '" + std::string(name) + "' (known: " + known + ")");
-  }
-  return vision::build_model(raw, std::string(name));
-}
-
-// ---- appearance helpers ---------------------------------------------------------------------
-
-// The seed of one of the object's procedural prints: the built-in one for print_seed 0, else a
-// different print for each print_seed (scene variety draws new package prints, labels, plates).
-std::uint64_t print(std::uint64_t builtin_seed, std::uint64_t print_seed) {
-  return print_seed == 0 ? builtin_seed : builtin_seed ^ (print_seed * 0x9e3779b97f4a7c15ULL);
-}
-
-int add_texture(Scene& s, cv::Mat t) {
-  s.textures.push_back(std::move(t));
-  return static_cast<int>(s.textures.size()) - 1;
-}
-int add_material(Scene& s, const Material& m) {
-  s.materials.push_back(m);
-  return static_cast<int>(s.materials.size()) - 1;
-}
-Material grey(double reflectance) {
-  Material m;
-  const float r = static_cast<float>(reflectance);
-  m.albedo_bgr = {r, r, r};
-  return m;
-}
-Material plain(float b, float g, float r) {
-  Material m;
-  m.albedo_bgr = {b, g, r};
-  return m;
-}
-
-// Texture mapping that shows the texture upright on a face seen from outside: origin at the
-// face's top-left corner (the loop's last vertex of a quad), u along the top edge, v down the left edge.
-void map_texture_on_face(Material& m, const vision::CadModel& model, int face, double px_per_m) {
-  const auto& loop = model.faces[static_cast<std::size_t>(face)].vertices;
-  const Vector3d& v0 = model.vertices[static_cast<std::size_t>(loop[0])];
-  const Vector3d& v2 = model.vertices[static_cast<std::size_t>(loop[2])];
-  const Vector3d& v3 = model.vertices[static_cast<std::size_t>(loop[3])];
-  m.tex_origin_obj = v3;
-  m.tex_u_obj = (v2 - v3).normalized();
-  m.tex_v_obj = (v0 - v3).normalized();
-  m.tex_px_per_m = px_per_m;
-}
-
-// The texture size that covers a quad face exactly at px_per_m.
-cv::Size face_texture_size(const vision::CadModel& model, int face, double px_per_m) {
-  const auto& loop = model.faces[static_cast<std::size_t>(face)].vertices;
-  const Vector3d& v0 = model.vertices[static_cast<std::size_t>(loop[0])];
-  const Vector3d& v2 = model.vertices[static_cast<std::size_t>(loop[2])];
-  const Vector3d& v3 = model.vertices[static_cast<std::size_t>(loop[3])];
-  return {static_cast<int>(std::lround((v2 - v3).norm() * px_per_m)), static_cast<int>(std::lround((v0 - v3).norm() * px_per_m))};
-}
-
-EnvironmentPlane wall(const Vector3d& centre_world, const Vector3d& facing_world, double width_m, double height_m,
-                      int texture) {
-  EnvironmentPlane p;
-  const Vector3d z = facing_world.normalized();
-  const Vector3d y = Vector3d::UnitZ();
-  p.world_T_plane.linear().col(0) = y.cross(z);
-  p.world_T_plane.linear().col(1) = y;
-  p.world_T_plane.linear().col(2) = z;
-  p.world_T_plane.translation() = centre_world;
-  p.width_m = width_m;
-  p.height_m = height_m;
-  p.texture = texture;
-  return p;
-}
-
-EnvironmentPlane floor_plane(double z_m, const Vector3d& centre, double width_m, double depth_m, int texture,
-                             double px_per_m) {
-  EnvironmentPlane p;
-  p.world_T_plane.translation() = Vector3d(centre.x(), centre.y(), z_m);
-  p.width_m = width_m;
-  p.height_m = depth_m;
-  p.texture = texture;
-  p.tex_px_per_m = px_per_m;
-  p.receives_shadow = true;
-  return p;
-}
-
-// Four walls around (cx, cy) from z0 up to z0 + height, each textured, facing inwards.
-void add_walls(Scene& s, double cx, double cy, double half_x, double half_y, double z0, double height,
-               const std::array<int, 4>& textures) {
-  const double zc = z0 + height / 2;
-  s.background.planes.push_back(wall({cx, cy + half_y, zc}, -Vector3d::UnitY(), 2 * half_x, height, textures[0]));
-  s.background.planes.push_back(wall({cx - half_x, cy, zc}, Vector3d::UnitX(), 2 * half_y, height, textures[1]));
-  s.background.planes.push_back(wall({cx + half_x, cy, zc}, -Vector3d::UnitX(), 2 * half_y, height, textures[2]));
-  s.background.planes.push_back(wall({cx, cy - half_y, zc}, Vector3d::UnitY(), 2 * half_x, height, textures[3]));
-}
-
-void set_view(Scene& s, const Vector3d& camera, const Vector3d& target, double min_m, double max_m) {
-  s.view.camera_world = camera;
-  s.view.target_world = target;
-  s.view.distance_m = (camera - target).norm();
-  s.view.min_distance_m = min_m;
-  s.view.max_distance_m = max_m;
-}
-
-// ---- the scenes -----------------------------------------------------------------------------
+using namespace scenes;
 
 std::expected<void, std::string> build_mockup_walk(Scene& s, std::uint64_t print_seed) {
   const int px_per_m = 500;  // 2 mm per texture pixel
@@ -483,25 +247,6 @@ std::expected<void, std::string> build_office_pan(Scene& s, std::uint64_t print_
   return {};
 }
 
-// A table top with clutter around it: a wooden floor plane at z = 0 and four walls of photos
-// and clutter (can, bowl).
-std::expected<void, std::string> add_table_surroundings(Scene& s, std::uint64_t clutter_seed, std::uint64_t wood_seed) {
-  auto desk = scene_photo("stuff.jpg");
-  if (!desk) return std::unexpected(desk.error());
-  auto street = scene_photo("building.jpg");
-  if (!street) return std::unexpected(street.error());
-  auto graffiti = scene_photo("graf1.jpg");
-  if (!graffiti) return std::unexpected(graffiti.error());
-  const int t_desk = add_texture(s, *desk), t_street = add_texture(s, *street), t_graf = add_texture(s, *graffiti);
-  const int t_clutter = add_texture(s, texture::clutter({1024, 640}, clutter_seed));
-  add_walls(s, 0, 0, 1.0, 1.0, 0.0, 1.2, {t_desk, t_clutter, t_graf, t_street});
-  s.background.planes.push_back(floor_plane(0.0, Vector3d::Zero(), 2.0, 2.0, add_texture(s, texture::wood({512, 512}, wood_seed)), 800));
-  s.background.plain_bgr = {0.8f, 0.8f, 0.8f};
-  s.shadows.enabled = true;
-  s.shadows.ground_z_m = 0.0;
-  return {};
-}
-
 std::expected<void, std::string> build_can(Scene& s, std::uint64_t print_seed) {
   // Smooth side (256 segments; the model's 32 facets would show as a polygon) in three bands:
   // a metal foot, the printed label, a metal shoulder; a lid and a bottom.
@@ -572,10 +317,8 @@ std::optional<std::string_view> scene_model_cao(std::string_view name) {
   return builtin_asset_text("scenes/" + std::string(name) + ".cao");
 }
 
-std::expected<vision::CadModel, std::string> make_scene_model(std::string_view name) { return model_of(name); }
-
 std::expected<Scene, std::string> make_scene(std::string_view name, std::uint64_t print_seed) {
-  auto model = model_of(name);
+  auto model = make_scene_model(name);
   if (!model) return std::unexpected(model.error());
   Scene s;
   s.name = std::string(name);

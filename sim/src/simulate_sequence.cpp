@@ -56,6 +56,29 @@ std::expected<void, std::string> write_text(const fs::path& path, const std::str
   return {};
 }
 
+// sim_truth.json: how the sequence was made (timing, the head's start angles, the IMU's drawn
+// errors, the scene variety).
+std::string truth_json(const Scenario& s, double exposure_s, int subframes, const SimSummary& summary,
+                       const HeadAngles& head0, const ImuRun& imu, const SceneVariety& drawn) {
+  std::ostringstream j;
+  j << "{\n  \"scenario\": \"" << s.name << "\",\n  \"scene\": \"" << s.scene << "\",\n  \"seed\": " << s.seed
+    << ",\n  \"frames\": " << s.frames << ",\n  \"fps\": " << num(s.fps) << ",\n  \"first_frame_s\": "
+    << num(s.frame_time_s(0)) << ",\n  \"exposure_s\": " << num(exposure_s) << ",\n  \"blur_subframes\": " << subframes
+    << ",\n  \"jerk\": " << num(s.motion == MotionKind::handheld ? s.handheld.jerk : s.walking.jerk) << ",\n  \"peak_body_rate_degps\": " << num(summary.peak_body_rate_degps)
+    << ",\n  \"head_deg\": [" << num(head0.pan_rad * rad2deg) << ", " << num(head0.tilt_rad * rad2deg) << "]"
+    << ",\n  \"imu\": {\n    \"time\": \"t_device_s = clock_offset_s + (1 + clock_drift) * t_true_s\",\n"
+    << "    \"clock_offset_s\": " << num(s.imu.clock_offset_s) << ",\n    \"clock_drift\": " << num(s.imu.clock_drift)
+    << ",\n    \"rate_hz\": " << num(s.imu.rate_hz) << ",\n    \"samples\": " << imu.samples.size()
+    << ",\n    \"dropped\": " << imu.dropped << ",\n    \"saturated\": " << imu.saturated
+    << ",\n    \"gyro_scale\": " << vec(imu.gyro_scale) << ",\n    \"accel_scale\": " << vec(imu.accel_scale)
+    << ",\n    \"gyro_bias0_radps\": " << vec(imu.gyro_bias0_radps) << ",\n    \"accel_bias0_mps2\": "
+    << vec(imu.accel_bias0_mps2) << "\n  }";
+  // Only with variety or covers, so that a built-in scene's output stays as it always was.
+  if (s.variety > 0 || !s.covers.empty()) j << ",\n  \"scene_variety\": " << to_json(drawn, "  ");
+  j << "\n}\n";
+  return j.str();
+}
+
 }  // namespace
 
 std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, const std::string& out_dir,
@@ -130,23 +153,8 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, 
   summary.imu_saturated = imu.saturated;
 
   const HeadAngles head0 = rig.head_angles(s.frame_time_s(0));
-  std::ostringstream j;
-  j << "{\n  \"scenario\": \"" << s.name << "\",\n  \"scene\": \"" << s.scene << "\",\n  \"seed\": " << s.seed
-    << ",\n  \"frames\": " << s.frames << ",\n  \"fps\": " << num(s.fps) << ",\n  \"first_frame_s\": "
-    << num(s.frame_time_s(0)) << ",\n  \"exposure_s\": " << num(exposure_s) << ",\n  \"blur_subframes\": " << subframes
-    << ",\n  \"jerk\": " << num(s.motion == MotionKind::handheld ? s.handheld.jerk : s.walking.jerk) << ",\n  \"peak_body_rate_degps\": " << num(summary.peak_body_rate_degps)
-    << ",\n  \"head_deg\": [" << num(head0.pan_rad * rad2deg) << ", " << num(head0.tilt_rad * rad2deg) << "]"
-    << ",\n  \"imu\": {\n    \"time\": \"t_device_s = clock_offset_s + (1 + clock_drift) * t_true_s\",\n"
-    << "    \"clock_offset_s\": " << num(s.imu.clock_offset_s) << ",\n    \"clock_drift\": " << num(s.imu.clock_drift)
-    << ",\n    \"rate_hz\": " << num(s.imu.rate_hz) << ",\n    \"samples\": " << imu.samples.size()
-    << ",\n    \"dropped\": " << imu.dropped << ",\n    \"saturated\": " << imu.saturated
-    << ",\n    \"gyro_scale\": " << vec(imu.gyro_scale) << ",\n    \"accel_scale\": " << vec(imu.accel_scale)
-    << ",\n    \"gyro_bias0_radps\": " << vec(imu.gyro_bias0_radps) << ",\n    \"accel_bias0_mps2\": "
-    << vec(imu.accel_bias0_mps2) << "\n  }";
-  // Only with variety or covers, so that a built-in scene's output stays as it always was.
-  if (s.variety > 0 || !s.covers.empty()) j << ",\n  \"scene_variety\": " << to_json(made->drawn, "  ");
-  j << "\n}\n";
-  if (auto ok = write_text(dir / "sim_truth.json", j.str()); !ok) return std::unexpected(ok.error());
+  const std::string sim_truth = truth_json(s, exposure_s, subframes, summary, head0, imu, made->drawn);
+  if (auto ok = write_text(dir / "sim_truth.json", sim_truth); !ok) return std::unexpected(ok.error());
   if (auto ok = write_text(dir / "scenario.scn", s.text); !ok) return std::unexpected(ok.error());
 
   // Frames last: the slow part.

@@ -29,7 +29,7 @@ struct ConeSpec {
 };
 
 // A lampshade-like cone about z: two rings of vertices, quads between them, the two rims
-// (as sim/src/scene_library.cpp models the lampshade), all moved by spec.world_T_cone.
+// (as sim/src/scene_models.cpp models the lampshade), all moved by spec.world_T_cone.
 RawModel cone_raw(const ConeSpec& spec) {
   RawModel raw;
   const Eigen::Isometry3d& T = spec.world_T_cone;
