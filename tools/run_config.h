@@ -11,7 +11,7 @@
 #include <string>
 
 #include "epichead/head/head_controller.h"
-#include "epichead/head/onboard_loop.h"
+#include "epichead/head/realtime_options.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
 

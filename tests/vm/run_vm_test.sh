@@ -204,7 +204,7 @@ set +e
 timeout --kill-after=10 "$timeout_s" "$qemu" "${cpu[@]}" -M pc -smp 2 -m 2048 \
   -display none -nodefaults -no-reboot -serial stdio -nic none \
   -kernel "$vmlinuz" -initrd "$work/initrd.cpio" \
-  -append "console=ttyS0 panic=-1 quiet loglevel=4 rdinit=/init" </dev/null | tee "$console"
+  -append "console=ttyS0 panic=-1 quiet loglevel=4 rdinit=/init epichead_accel=$accel" </dev/null | tee "$console"
 qemu_rc=${PIPESTATUS[0]}
 set -e
 elapsed=$((SECONDS - start_s))

@@ -8,6 +8,8 @@
 #include <system_error>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "epichead/vision/cao_model.h"
 
 namespace epichead::vision {

@@ -29,6 +29,7 @@
 #include "epichead/head/device_clock_sync.h"
 #include "epichead/head/head_controller.h"
 #include "epichead/head/imu_frame_assembler.h"
+#include "epichead/head/realtime_options.h"
 #include "epichead/hw/camera_port.h"
 #include "epichead/hw/can_bus.h"
 #include "epichead/hw/clock.h"
@@ -47,14 +48,6 @@ struct OnboardPorts {
 // How the vision stage and the recorder run: Inline (deterministic, the simulator) or on threads of
 // their own (the robot; `sim-run --threads wall`).
 enum class VisionThreads { Inline, Thread };
-
-// Scheduling of the threads (Thread mode): see realtime.h for what happens when it is refused.
-struct RealtimeOptions {
-  int control_cpu = -1, vision_cpu = -1;  // pin to this CPU (-1: leave to the scheduler)
-  int control_priority = 0;               // SCHED_FIFO priority 1..99 of the control thread (0: normal)
-  int vision_priority = 0;                // the same for the vision worker (below the control thread's)
-  bool lock_memory = false;               // mlockall: no page faults on the control thread after start-up
-};
 
 struct OnboardOptions {
   double control_rate_hz = 1000;
