@@ -119,6 +119,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   ports.clock = &w.clock();
   ports.bus = &w.bus();
   ports.camera = &w.camera();
+  ports.simulated = true;
   // With wall-clock threads the simulated time keeps pace with the wall clock (never ahead of it),
   // so that the vision thread works against the control loop's real rate, as on the robot.
   const auto wall_start = std::chrono::steady_clock::now();

@@ -246,6 +246,15 @@ ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
   return options;
 }
 
+// IMU samples the predictor could not use are counted in report.json; say so where it is seen.
+void warn_dropped_imu(const nlohmann::json& predictor) {
+  const std::uint64_t rejected = predictor.value("imu_rejected", std::uint64_t{0});
+  if (rejected == 0) return;
+  std::fprintf(stderr, "track: %llu IMU samples dropped (%llu saturated or beyond any sensor's range); report.json: predictor\n",
+               static_cast<unsigned long long>(rejected),
+               static_cast<unsigned long long>(predictor.value("imu_saturated", std::uint64_t{0})));
+}
+
 int run_track(const TrackArgs& args) {
   const char* cmd = "track";
   static const std::map<std::string, TrackMode> modes{
@@ -361,12 +370,7 @@ int run_track(const TrackArgs& args) {
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
               args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");
   if (!overlays.video_note().empty()) std::fprintf(stderr, "track: %s\n", printable(overlays.video_note()).c_str());
-  // IMU samples the predictor could not use are counted in report.json; say so where it is seen.
-  const nlohmann::json& pd = j["predictor"];
-  if (pd.contains("imu_rejected") && pd["imu_rejected"].get<std::uint64_t>() > 0)
-    std::fprintf(stderr, "track: %llu IMU samples dropped (%llu saturated or beyond any sensor's range); report.json: predictor\n",
-                 static_cast<unsigned long long>(pd["imu_rejected"].get<std::uint64_t>()),
-                 static_cast<unsigned long long>(pd.value("imu_saturated", std::uint64_t{0})));
+  warn_dropped_imu(j["predictor"]);
   return 0;
 }
 

@@ -77,6 +77,7 @@ struct OnboardLoop::Impl {
   RecentSamples lateness_us{1 << 18}, vision_latency_ms{1 << 14};
   double lateness_us_max = 0, tick_work_us_max = 0, vision_latency_ms_max = 0;  // over the whole run
   std::uint64_t frame_index = 0;
+  double camera_read_ms = 0;  // wall time of this tick's next_frame() (the simulator renders in it)
   double next_sync_s = 0, next_diag_s = 0;
   std::uint64_t heartbeats = 0;
 
@@ -137,7 +138,9 @@ struct OnboardLoop::Impl {
   // Returns whether a job was submitted.
   bool take_frame(double now_s) {
     hw::CameraFrame frame;
+    const auto t0 = WallClock::now();
     const hw::CameraRead r = ports.camera->next_frame(frame, 0);
+    camera_read_ms = wall_ms_since(t0);
     if (r == hw::CameraRead::Lost) ++summary.camera_lost;
     if (r != hw::CameraRead::Frame) return false;
     if (vision.busy()) {
@@ -258,8 +261,11 @@ struct OnboardLoop::Impl {
       ++summary.commands_withheld;
     }
     diagnose(now_s, out);
-    // The tick's own work: inline tracking is the vision stage's time, not the control loop's.
-    const double work_ms = std::max(0.0, wall_ms_since(t0) - inline_vision_ms);
+    // The tick's own work: inline tracking is the vision stage's time, not the control loop's;
+    // the simulator's camera renders the frame inside next_frame(), which is the simulator's time
+    // too. On the robot a camera read is a dequeue and counts.
+    const double simulator_ms = ports.simulated ? camera_read_ms : 0;
+    const double work_ms = std::max(0.0, wall_ms_since(t0) - inline_vision_ms - simulator_ms);
     tick_ms.push(work_ms);
     tick_work_us_max = std::max(tick_work_us_max, 1e3 * work_ms);
   }

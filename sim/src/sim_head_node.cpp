@@ -8,6 +8,7 @@
 #include "epichead/firmware_iface/head_status.h"
 #include "epichead/firmware_iface/heartbeat.h"
 #include "epichead/firmware_iface/version.h"
+#include "node_heartbeat.h"
 
 namespace epichead::sim {
 namespace {
@@ -163,14 +164,7 @@ fw::CanFrame SimHeadNode::status_frame() {
 }
 
 fw::CanFrame SimHeadNode::heartbeat_frame(double t_s) {
-  fw::Heartbeat h;
-  h.node = fw::kNodeHead;
-  h.state = faults_ == 0 ? fw::NodeState::Operational : fw::NodeState::Degraded;
-  h.protocol_version = fw::kProtocolVersion;
-  h.firmware_major = 1;
-  h.uptime_s = static_cast<std::uint32_t>(std::max(0.0, t_s));
-  auto e = fw::encode(h);
-  return e ? e->frame : fw::CanFrame{};
+  return node_heartbeat_frame(fw::kNodeHead, faults_ == 0 ? fw::NodeState::Operational : fw::NodeState::Degraded, t_s);
 }
 
 }  // namespace epichead::sim

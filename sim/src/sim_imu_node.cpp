@@ -7,6 +7,7 @@
 #include "epichead/firmware_iface/heartbeat.h"
 #include "epichead/firmware_iface/imu_frames.h"
 #include "epichead/firmware_iface/version.h"
+#include "node_heartbeat.h"
 #include "saturate.h"
 
 namespace epichead::sim {
@@ -73,14 +74,7 @@ std::uint64_t SimImuNode::device_us(double t_true_s) const {
 }
 
 fw::CanFrame SimImuNode::heartbeat_frame(double t_s) const {
-  fw::Heartbeat h;
-  h.node = fw::kNodeImu;
-  h.state = fw::NodeState::Operational;
-  h.protocol_version = fw::kProtocolVersion;
-  h.firmware_major = 1;
-  h.uptime_s = static_cast<std::uint32_t>(std::max(0.0, t_s));
-  auto e = fw::encode(h);
-  return e ? e->frame : fw::CanFrame{};
+  return node_heartbeat_frame(fw::kNodeImu, fw::NodeState::Operational, t_s);
 }
 
 }  // namespace epichead::sim

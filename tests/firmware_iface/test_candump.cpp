@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include "common/temp_dir.h"
 #include "epichead/firmware_iface/candump_reader.h"
@@ -14,7 +15,8 @@ using namespace epichead::firmware_iface;
 
 namespace {
 
-CandumpRecord parse_ok(const std::string& line) {
+// The line is a view of the caller's text (a literal): the record's iface points into it.
+CandumpRecord parse_ok(std::string_view line) {
   CandumpRecord r;
   const CandumpParse p = parse_candump_line(line, r);
   INFO(line << " -> " << p.reason);

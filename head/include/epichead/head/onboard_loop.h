@@ -43,6 +43,9 @@ struct OnboardPorts {
   hw::CameraPort* camera = nullptr;
   // Blocks (robot) or advances simulated time (simulator) until the clock reads t_s.
   std::function<std::expected<void, std::string>(double t_s)> wait_until;
+  // The simulator's ports: its camera renders the frame inside next_frame(), which the tick's
+  // work figure (OnboardSummary::tick_work_us_*) then leaves out, as the simulator's time.
+  bool simulated = false;
 };
 
 // How the vision stage and the recorder run: Inline (deterministic, the simulator) or on threads of
