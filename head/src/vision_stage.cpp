@@ -80,15 +80,14 @@ void VisionStage::submit(double now_s) {
   const auto t0 = std::chrono::steady_clock::now();
   track_job();
   inline_wall_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  publish_t_s_ = processing_s_ >= 0 ? now_s + processing_s_ : clock_.now_s();
-  result_.done_t_s = publish_t_s_;
+  result_.done_t_s = processing_s_ >= 0 ? now_s + processing_s_ : clock_.now_s();
 }
 
 const VisionResult* VisionStage::poll(double now_s) {
   if (!busy_) return nullptr;
   if (threads_ == VisionThreads::Thread)
     return done_.load(std::memory_order_acquire) == submitted_.load(std::memory_order_relaxed) ? &result_ : nullptr;
-  return now_s >= publish_t_s_ ? &result_ : nullptr;
+  return now_s >= result_.done_t_s ? &result_ : nullptr;
 }
 
 void VisionStage::release() { busy_ = false; }

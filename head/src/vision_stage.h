@@ -92,7 +92,6 @@ class VisionStage {
   vision::FrameReport report_;
   VisionJob job_;
   VisionResult result_;
-  double publish_t_s_ = 0;
   double inline_wall_ms_ = 0;
   bool busy_ = false;  // control thread: a job submitted and not yet released
   // Thread mode: the job and result slots are handed over by these sequence numbers (a job is
