@@ -132,7 +132,10 @@ run() {
   timeout 60 "$bin" "$@" > "$W/.out" 2> "$W/.err" < /dev/null
   local code=$?
   local message
-  message="$(grep -m1 -v '^[[:space:]]*$' "$W/.err")"
+  # The program's own line, not a library's (FFmpeg and libpng write theirs first, FFmpeg's
+  # with a pointer that differs from run to run).
+  message="$(grep -m1 '^epichead' "$W/.err")"
+  [[ -z "$message" ]] && message="$(grep -m1 -v '^[[:space:]]*$' "$W/.err")"
   [[ -z "$message" ]] && message="$(grep -m1 -v '^[[:space:]]*$' "$W/.out")"
   # Paths in the scratch and data folders are shown relative to them; bytes that are not
   # printable (there should be none: printable.h) as '?'.

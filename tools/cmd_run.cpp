@@ -3,7 +3,6 @@
 // described in run_config.h.
 #include <CLI/CLI.hpp>
 
-#include <signal.h>
 #include <time.h>
 
 #include <cmath>
@@ -15,6 +14,7 @@
 #include <map>
 
 #include "command.h"
+#include "stop_signals.h"
 #include "onboard_summary_json.h"
 #include "run_config.h"
 #include "epichead/head/onboard_loop.h"
@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 
 // Ctrl-C or SIGTERM ends the run after the current tick, so the logs and the summary are written.
 std::atomic<head::OnboardLoop*> running_loop{nullptr};
-extern "C" void on_stop_signal(int) {
+extern "C" void on_run_stop_signal(int) {
   if (head::OnboardLoop* loop = running_loop.load()) loop->request_stop();
 }
 
@@ -94,16 +94,14 @@ int run_onboard(const std::string& config_path, double seconds) {
   options.diagnostics_path = (fs::path(config->out) / "diagnostics.jsonl").string();
   // Vision and recording on threads of their own: the control loop never waits for them.
   options.threads = head::VisionThreads::Thread;
+  options.imu_clock_sync.max_round_trip_s = config->time_sync_max_round_trip_s;
   options.realtime = config->threads;
   auto loop = head::OnboardLoop::create(*model, *camera_model, options, ports);
   if (!loop) return fail(cmd, loop.error());
   (*loop)->set_initial_pose(clock.now_s(), init->front().cam_T_obj);
   const double until = seconds > 0 ? clock.now_s() + seconds : std::numeric_limits<double>::infinity();
   running_loop.store(loop->get());
-  struct sigaction action{};
-  action.sa_handler = on_stop_signal;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  on_stop_signals(on_run_stop_signal);
   auto summary = (*loop)->run(until);
   running_loop.store(nullptr);
   if (!summary) return fail(cmd, summary.error());
@@ -116,12 +114,22 @@ int run_onboard(const std::string& config_path, double seconds) {
               static_cast<unsigned long long>(summary->frames), static_cast<unsigned long long>(summary->tracked),
               static_cast<unsigned long long>(summary->lost), static_cast<unsigned long long>(summary->imu_samples),
               static_cast<unsigned long long>(summary->commands_sent));
+  if (summary->imu_samples == 0) {
+    const head::ClockSyncCounters& sync = summary->imu_clock;
+    std::printf("run: warning: no IMU samples: %s (%llu time-sync requests, %llu replies used, %llu refused for a "
+                "round trip over %.0f ms or no matching request)\n",
+                sync.replies == 0 ? "the IMU's clock was never synchronised" : "no gyro/accelerometer pair was accepted (summary.json: imu_assembly, imu_rejected)",
+                static_cast<unsigned long long>(sync.requests), static_cast<unsigned long long>(sync.replies),
+                static_cast<unsigned long long>(sync.rejected), options.imu_clock_sync.max_round_trip_s * 1e3);
+  }
   const hw::CanBusStats bus_stats = (*bus)->stats();
   std::printf("run: tracking %.1f ms median, tick work %.2f ms median; bus: %llu frames received, %llu dropped by the "
-              "kernel (receive queue full), %llu sends failed; camera: %llu frames dropped by the device\n",
+              "kernel (receive queue full), %llu sends failed; camera: %llu frames dropped by the device, %llu stamped "
+              "ahead of the loop's clock\n",
               summary->track_ms_median, summary->tick_ms_median, static_cast<unsigned long long>(bus_stats.rx_frames),
               static_cast<unsigned long long>(bus_stats.rx_dropped), static_cast<unsigned long long>(bus_stats.tx_failed),
-              static_cast<unsigned long long>((*camera)->stats().dropped_frames));
+              static_cast<unsigned long long>((*camera)->stats().dropped_frames),
+              static_cast<unsigned long long>(summary->frames_stamped_ahead));
   std::printf("run: control ticks late %.0f us median, %.0f us p99, %.0f us max; %llu of %llu ticks missed (%.3f %%); "
               "vision latency %.1f ms median, %.1f ms p99; %llu frames dropped while vision was busy; %llu log records "
               "dropped\n",

@@ -43,6 +43,7 @@ struct SimRunArgs {
   long long seed = -1;
   double jerk = -1;
   double settle_s = 2.0;
+  double told_backlash_rad = -1;  // < 0: the controller is told the scenario's true backlash
   std::string threads = "simulated";  // simulated (deterministic) | wall (vision on its own thread, as on the robot)
 };
 
@@ -91,7 +92,9 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   o.mode = mode;
   // The head's gear backlash as the controller's calibration: the simulator knows the truth
   // (scenario key head_backlash_rad, both joints); on the robot it comes from the configuration.
-  o.controller.backlash = {scenario.head_dynamics.backlash_rad, scenario.head_dynamics.backlash_rad};
+  // --told-backlash-rad gives it another figure (0: not told), as a mis-calibrated robot would.
+  const double told = a.told_backlash_rad >= 0 ? a.told_backlash_rad : scenario.head_dynamics.backlash_rad;
+  o.controller.backlash = {told, told};
   o.processing_s = a.processing_ms * 1e-3;
   const bool wall = a.threads == "wall";
   if (wall) o.threads = head::VisionThreads::Thread;  // processing_s is then what tracking really takes
@@ -313,6 +316,9 @@ const CommandRegistration registration{
           ->check(CLI::IsMember({"simulated", "wall"}));
       app.add_option("--settle-s", a->settle_s, "Leave the first S seconds (the first slew) out of the rate RMS (default 2)")
           ->check(CLI::Range(0.0, 1e6));
+      app.add_option("--told-backlash-rad", a->told_backlash_rad,
+                     "The gear backlash the controller is told (default: the scenario's true head_backlash_rad; 0: none)")
+          ->check(CLI::Range(0.0, 0.5));
       return [a]() { return run_sim_run(*a); };
     }};
 

@@ -80,11 +80,13 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
   char devices[512];
   std::snprintf(devices, sizeof devices,
                 "    \"camera\": { \"device\": \"%s\", \"width\": %d, \"height\": %d, \"fps\": %g },\n"
-                "    \"can\": { \"interface\": \"%s\" },\n"
+                "    \"can\": { \"interface\": \"%s\", \"receive_buffer_bytes\": %d,\n"
+                "             \"time_sync_max_round_trip_ms\": %g },\n"
                 "    \"head\": { \"pan_backlash_rad\": %g, \"tilt_backlash_rad\": %g },\n"
                 "    \"threads\": { \"control_cpu\": %d, \"vision_cpu\": %d, \"control_priority\": %d,\n"
                 "                 \"vision_priority\": %d, \"lock_memory\": %s },\n",
                 d.camera.device.c_str(), d.camera.width, d.camera.height, d.camera.frame_rate_hz, d.can.interface.c_str(),
+                d.can.receive_buffer_bytes, d.time_sync_max_round_trip_s * 1e3,
                 d.backlash.pan_rad, d.backlash.tilt_rad, d.threads.control_cpu, d.threads.vision_cpu,
                 d.threads.control_priority, d.threads.vision_priority, d.threads.lock_memory ? "true" : "false");
   return "The configuration (JSON; relative paths from its folder; every key but the three files has\n"
@@ -94,7 +96,9 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          std::string(devices) + "    \"controller\": { " + gains + " },\n    \"mode\": \"" + d.mode +
          "\",\n    \"out\": \"" + d.out +
          "\" }\n"
-         "fps 0: the driver's current rate. Backlash: the gear's dead band per joint (0: none). The\n"
+         "fps 0: the driver's current rate. receive_buffer_bytes: the kernel's CAN receive queue (0: its\n"
+         "default; without CAP_NET_ADMIN capped at net.core.rmem_max). time_sync_max_round_trip_ms: longer\n"
+         "time-sync round trips with the IMU are ignored (at most 60; raise it only on a loaded machine). Backlash: the gear's dead band per joint (0: none). The\n"
          "controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.\n"
          "threads: the CPU each thread is pinned to (-1: any) and its SCHED_FIFO priority (1..99; 0: normal\n"
          "scheduling); lock_memory locks the process in RAM. A refusal (no CAP_SYS_NICE or rtprio limit)\n"
@@ -136,7 +140,18 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
       c.camera.height = static_cast<int>(*height);
       c.camera.frame_rate_hz = *fps;
     }
-    if (j.contains("can")) c.can.interface = j["can"].value("interface", c.can.interface);
+    if (j.contains("can")) {
+      const auto& can = j["can"];
+      if (!can.is_object()) return fail("can must be an object");
+      c.can.interface = can.value("interface", c.can.interface);
+      const auto queue = number(can, "can", "receive_buffer_bytes", c.can.receive_buffer_bytes, 0, 1 << 30, true);
+      if (!queue) return fail(queue.error());
+      c.can.receive_buffer_bytes = static_cast<int>(*queue);
+      const auto round_trip = number(can, "can", "time_sync_max_round_trip_ms", c.time_sync_max_round_trip_s * 1e3, 0.1,
+                                     head::kMaxClockSyncRoundTrip_s * 1e3, false);
+      if (!round_trip) return fail(round_trip.error());
+      c.time_sync_max_round_trip_s = *round_trip * 1e-3;
+    }
     if (j.contains("head")) {
       const auto& h = j["head"];
       if (!h.is_object()) return fail("head must be an object");

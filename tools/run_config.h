@@ -12,6 +12,7 @@
 
 #include "epichead/head/head_controller.h"
 #include "epichead/head/realtime_options.h"
+#include "epichead/head/device_clock_sync.h"
 #include "epichead/hw/socketcan_bus.h"
 #include "epichead/hw/v4l2_camera.h"
 
@@ -21,6 +22,7 @@ struct RunConfig {
   std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
+  double time_sync_max_round_trip_s = head::ClockSyncOptions{}.max_round_trip_s;  // "can": time_sync_max_round_trip_ms
   head::JointBacklash backlash;
   head::RealtimeOptions threads;  // "threads": CPUs and real-time priorities of the control and vision threads
   // The controller's gains the file gives; the others keep HeadControllerOptions' defaults.

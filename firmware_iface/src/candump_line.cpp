@@ -291,4 +291,12 @@ std::size_t format_candump_line(const StampedCanFrame& s, std::string_view iface
   return static_cast<std::size_t>(p - buf);
 }
 
+const char* candump_iface_problem(std::string_view iface) {
+  if (iface.empty()) return "is empty";
+  if (iface.find_first_of(" \t\r\n") != std::string_view::npos) return "has blanks";
+  static_assert(kCandumpMaxIface == 15, "the message below names the limit");
+  if (iface.size() > kCandumpMaxIface) return "is longer than 15 characters";
+  return nullptr;
+}
+
 }  // namespace epichead::firmware_iface

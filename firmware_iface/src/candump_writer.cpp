@@ -42,11 +42,8 @@ CandumpWriter::~CandumpWriter() {
 std::expected<void, std::string> CandumpWriter::write(const StampedCanFrame& frame, std::string_view iface,
                                                       CanDirection direction) {
   if (!file_) return std::unexpected(path_ + ": writer is closed");
-  if (iface.empty() || iface.find_first_of(" \t\r\n") != std::string_view::npos)
-    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is empty or has blanks");
-  if (iface.size() > kCandumpMaxIface)
-    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' is longer than " +
-                           std::to_string(kCandumpMaxIface) + " characters");
+  if (const char* why = candump_iface_problem(iface))
+    return std::unexpected(path_ + ": interface name '" + std::string(iface) + "' " + why);
   if (const char* why = impossible_frame_reason(frame.frame))
     return std::unexpected(path_ + ": cannot record CAN id 0x" + hex_id(frame.frame.id) + ": " + why);
   // The reader takes (seconds.microseconds) with 1 to 12 digits of seconds, none negative.

@@ -29,9 +29,12 @@ std::optional<fusion::ImuSample> ImuFrameAssembler::on_accel(const firmware_ifac
 
 std::optional<fusion::ImuSample> ImuFrameAssembler::join(double now_s, const DeviceClockSync& sync) {
   if (!gyro_ || !accel_) return std::nullopt;
-  // The newest device time with this stamp that is not after the receive time.
+  // The newest device time with this stamp that is not after the receive time, read on the
+  // device's clock through the sync; the allowance covers the sync's error (half its round
+  // trip) and 2 ms of margin, so a stamp just before the receive time is not put a wrap back.
   constexpr std::int64_t wrap = firmware_iface::kImuStampWrapUs;
-  const std::int64_t received_us = sync.device_us_at(now_s) + 2000;  // allowance for the sync's error
+  const auto allowance_us = 2000 + static_cast<std::int64_t>(sync.max_error_s() * 1e6);
+  const std::int64_t received_us = sync.device_us_at(now_s) + allowance_us;
   const std::int64_t back = ((received_us - static_cast<std::int64_t>(gyro_->stamp_mod_us)) % wrap + wrap) % wrap;
   const std::int64_t device_us = received_us - back;
   fusion::ImuSample s;

@@ -24,6 +24,13 @@ namespace {
 namespace fw = firmware_iface;
 using WallClock = std::chrono::steady_clock;
 
+// The bus is read once per control tick.
+ClockSyncOptions clock_sync_options(const OnboardOptions& o) {
+  ClockSyncOptions c = o.imu_clock_sync;
+  c.read_resolution_s = 1.0 / o.control_rate_hz;
+  return c;
+}
+
 double wall_ms_since(WallClock::time_point t0) {
   return std::chrono::duration<double, std::milli>(WallClock::now() - t0).count();
 }
@@ -42,7 +49,8 @@ struct OnboardLoop::Impl {
        fusion::Predictor pred, HeadController ctrl, std::unique_ptr<Recorder> rec)
       : model(&m), camera(cam), options(o), ports(p),
         vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
-        controller(std::move(ctrl)), target_point_obj(model_centre(m)), recorder(std::move(rec)) {}
+        controller(std::move(ctrl)), target_point_obj(model_centre(m)), imu_clock(clock_sync_options(o)),
+        recorder(std::move(rec)) {}
 
   const vision::CadModel* model;
   vision::Camera camera;
@@ -147,7 +155,13 @@ struct OnboardLoop::Impl {
       ++summary.frames_dropped_vision_busy;
       return false;
     }
-    const double exposure = frame.t_s;
+    // A frame cannot have been exposed after it arrived: a stamp ahead of the loop's clock (a
+    // driver that stamps the frame's scheduled time, as vivid does under load) is taken as now.
+    double exposure = frame.t_s;
+    if (exposure > now_s) {
+      ++summary.frames_stamped_ahead;
+      exposure = now_s;
+    }
     if (init_pending) {
       const auto v = predictor.add_vision(init_t_s, last_good, vision::initial_pose_covariance()).verdict;
       init_pending = v != fusion::VisionVerdict::Initialised && v != fusion::VisionVerdict::Applied;
@@ -280,6 +294,9 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
                                                                               const OnboardPorts& ports) {
   if (!ports.clock || !ports.bus || !ports.camera || !ports.wait_until)
     return std::unexpected("onboard loop: clock, bus, camera and wait_until are all needed");
+  if (const double rt = options.imu_clock_sync.max_round_trip_s; !(rt > 0 && rt <= kMaxClockSyncRoundTrip_s))
+    return std::unexpected("onboard loop: imu_clock_sync.max_round_trip_s must be in (0, " +
+                           std::to_string(kMaxClockSyncRoundTrip_s) + "] s, got " + std::to_string(rt));
   if (!(options.control_rate_hz > 0) || !(options.time_sync_period_s > 0) || !(options.diagnostics_period_s > 0))
     return std::unexpected("onboard loop: control_rate_hz, time_sync_period_s and diagnostics_period_s must be > 0");
   fusion::PredictorOptions p = options.predictor;
@@ -289,9 +306,8 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
   auto controller = HeadController::create(options.controller);
   if (!controller) return std::unexpected("onboard loop: head controller: " + controller.error());
   controller->request(options.mode);
-  if (options.candump_iface.empty() || options.candump_iface.size() > fw::kCandumpMaxIface ||
-      options.candump_iface.find_first_of(" \t\r\n") != std::string::npos)
-    return std::unexpected("onboard loop: CAN interface name '" + options.candump_iface + "' cannot be recorded");
+  if (const char* why = fw::candump_iface_problem(options.candump_iface))
+    return std::unexpected("onboard loop: CAN interface name '" + options.candump_iface + "' cannot be recorded: it " + why);
   auto recorder = Recorder::open(options.candump_path, options.candump_iface, options.diagnostics_path,
                                  options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline);
   if (!recorder) return std::unexpected("onboard loop: " + recorder.error());
@@ -376,6 +392,7 @@ std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, cons
   out.result_to_command_ms_max = s.overhead_ms.max();
   out.controller = s.controller.counters();
   out.imu_assembly = s.assembler.counters();
+  out.imu_clock = s.imu_clock.counters();
   out.predictor = s.predictor.status(s.ports.clock->now_s()).counters;
   return out;
 }

@@ -60,14 +60,11 @@ void VisionStage::track_job() {
   result_.report = &report_;
   result_.tracker = &tracker_;
   result_.image = &job_.frame;
+  const auto t0 = std::chrono::steady_clock::now();
   const cv::Mat mat = as_image(job_.frame, converted_);
   result_.readable = !mat.empty() && image_.assign(mat).has_value();
-  result_.track_ms = 0;
-  if (result_.readable) {
-    const auto t0 = std::chrono::steady_clock::now();
-    tracker_.track(image_, job_.predicted, report_);
-    result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  }
+  if (result_.readable) tracker_.track(image_, job_.predicted, report_);
+  result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void VisionStage::submit(double now_s) {
@@ -77,9 +74,7 @@ void VisionStage::submit(double now_s) {
     submitted_.notify_one();
     return;
   }
-  const auto t0 = std::chrono::steady_clock::now();
   track_job();
-  inline_wall_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result_.done_t_s = processing_s_ >= 0 ? now_s + processing_s_ : clock_.now_s();
 }
 

@@ -45,7 +45,7 @@ struct VisionResult {
   std::uint64_t index = 0;
   double exposure_t_s = 0, taken_t_s = 0;
   double done_t_s = 0;     // Inline: loop clock when the result is published (modelled); Thread: unset
-  double track_ms = 0;     // wall time of the tracking step itself
+  double track_ms = 0;     // wall time of the job: the image's conversion and the tracking
   bool readable = true;    // false: a pixel format the tracker cannot read (nothing was tracked)
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
   const vision::FrameReport* report = nullptr;
@@ -76,7 +76,7 @@ class VisionStage {
   const VisionResult* poll(double now_s);
   void release();  // done with the result: the stage takes a new job
 
-  double inline_wall_ms() const { return inline_wall_ms_; }  // Inline: wall time of the last submit's tracking
+  double inline_wall_ms() const { return result_.track_ms; }  // Inline: wall time of the last submit's job
 
  private:
   void track_job();  // the stage's work: the job's frame -> result (either thread)
@@ -92,7 +92,6 @@ class VisionStage {
   vision::FrameReport report_;
   VisionJob job_;
   VisionResult result_;
-  double inline_wall_ms_ = 0;
   bool busy_ = false;  // control thread: a job submitted and not yet released
   // Thread mode: the job and result slots are handed over by these sequence numbers (a job is
   // posted when submitted_ moves past done_, its result when done_ catches up).

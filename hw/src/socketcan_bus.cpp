@@ -69,6 +69,17 @@ std::expected<std::unique_ptr<SocketCanBus>, std::string> SocketCanBus::open(con
   if (sys.setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on) < 0) {
     return std::unexpected(open_error(name, "cannot enable the drop counter (SO_RXQ_OVFL)", errno));
   }
+  if (options.receive_buffer_bytes < 0) {
+    return std::unexpected("SocketCAN interface '" + name + "': receive_buffer_bytes must be >= 0");
+  }
+  if (options.receive_buffer_bytes > 0) {
+    const int bytes = options.receive_buffer_bytes;
+    // Without CAP_NET_ADMIN the forced size is refused and the plain one is capped, not refused.
+    if (sys.setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &bytes, sizeof bytes) < 0 &&
+        sys.setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &bytes, sizeof bytes) < 0) {
+      return std::unexpected(open_error(name, "cannot size the receive queue (SO_RCVBUF)", errno));
+    }
+  }
   sockaddr_can address{};
   address.can_family = AF_CAN;
   address.can_ifindex = request.ifr_ifindex;

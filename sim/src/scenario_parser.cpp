@@ -412,7 +412,9 @@ class Parser {
     numbers("head_rate_limit_radps", {&h.rate_limit_radps}, 0.01, 100);
     numbers("head_accel_limit_radps2", {&h.accel_limit_radps2}, 0.1, 1e5);
     numbers("head_backlash_rad", {&h.backlash_rad}, 0, 0.5);
+    numbers("head_friction_radps2", {&h.friction_radps2}, 0, 1e4);
     numbers("head_state_rate_hz", {&h.state_rate_hz}, 1, 10000);
+    numbers("head_servo_rate_hz", {&h.servo_rate_hz}, 100, 100000);
     numbers("head_command_timeout_s", {&h.command_timeout_s}, 0.001, 1e6);
     numbers("camera_latency_s", {&sc_.camera_latency_s}, 0, 10);
     rules_["fault"] = {3, 4, true, std::nullopt, [this](const Args& a) -> Status {

@@ -13,6 +13,16 @@
 namespace epichead::sim {
 namespace {
 
+// The acceleration left of the drive's `accel` after Coulomb friction `f` (both rad/s^2): taken
+// off against the motion; a moving joint that friction alone would turn round stops instead, and
+// a joint at rest stays until the drive exceeds the friction (stiction).
+double with_friction(double rate, double accel, double f, double dt_s) {
+  if (rate == 0) return std::abs(accel) <= f ? 0.0 : accel - std::copysign(f, accel);
+  const double a = accel - std::copysign(f, rate);
+  const bool reverses = (rate > 0) != (rate + a * dt_s > 0);
+  return reverses && std::abs(accel) <= f ? -rate / dt_s : a;
+}
+
 namespace fw = firmware_iface;
 
 void advance(JointMotion& m, double h) {
@@ -105,6 +115,7 @@ void SimHeadNode::plan_joint(int j, double t_s, bool stuck, JointMotion& motor, 
   faults_ &= static_cast<std::uint16_t>(~over_current);
 
   double accel = std::clamp((desired - motor.rate_radps) / dt_s_, -dyn_.accel_limit_radps2, dyn_.accel_limit_radps2);
+  if (dyn_.friction_radps2 > 0) accel = with_friction(motor.rate_radps, accel, dyn_.friction_radps2, dt_s_);
   const double next_angle = motor.angle_rad + motor.rate_radps * dt_s_ + 0.5 * accel * dt_s_ * dt_s_;
   if ((next_angle > hi && desired >= 0) || (next_angle < lo && desired <= 0)) {
     // The end stop: the joint stops dead there.

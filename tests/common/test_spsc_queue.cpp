@@ -10,7 +10,7 @@
 
 using epichead::common::SpscQueue;
 
-TEST_CASE("spsc queue: first in, first out; full refuses; empty gives nothing", "[common][spsc]") {
+TEST_CASE("spsc queue: first in, first out, full refuses, empty gives nothing", "[common][spsc]") {
   SpscQueue<int> q(3);
   CHECK(q.capacity() == 3);
   int out = -1;

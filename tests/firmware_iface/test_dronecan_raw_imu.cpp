@@ -116,7 +116,7 @@ TEST_CASE("A lost frame breaks the toggle sequence and the transfer is dropped")
   CHECK(ok->has_value());
 }
 
-TEST_CASE("Transfers from two nodes interleave; a stale transfer times out after 2 s") {
+TEST_CASE("Transfers from two nodes interleave, a stale transfer times out after 2 s") {
   DroneCanRawImuDecoder decoder;
   const std::uint32_t other = (kId & ~0x7Fu) | 43;
   int complete = 0;
@@ -136,7 +136,7 @@ TEST_CASE("Transfers from two nodes interleave; a stale transfer times out after
   CHECK(decoder.transfers_timed_out() == 1);
 }
 
-TEST_CASE("Frames that are not RawIMU are ignored; malformed tail bytes are rejected") {
+TEST_CASE("Frames that are not RawIMU are ignored, malformed tail bytes are rejected") {
   DroneCanRawImuDecoder decoder;
   auto other_type = make(kFrames[0], 0, (16u << 24) | (1002u << 8) | 42u);
   auto r = decoder.push(other_type);

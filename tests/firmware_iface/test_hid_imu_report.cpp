@@ -40,7 +40,7 @@ TEST_CASE("HID IMU report bytes follow the documented layout") {
   CHECK(std::vector<std::uint8_t>(r->bytes.begin(), r->bytes.end()) == expected);
 }
 
-TEST_CASE("HID IMU report rejects a wrong report id, a short report and NaN; clips and flags saturation") {
+TEST_CASE("HID IMU report rejects a wrong report id, a short report and NaN, clips and flags saturation") {
   auto r = encode_hid_imu_report(ImuSample{});
   REQUIRE(r);
   auto bytes = r->bytes;

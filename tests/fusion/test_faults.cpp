@@ -156,7 +156,7 @@ TEST_CASE("after reinit_after_gated gated poses in a row the next pose re-initia
   CHECK((pred->cam_T_obj.translation() - (jump * r.traj.at(0.48).x.cam_T_obj()).translation()).norm() < 0.01);
 }
 
-TEST_CASE("reset forgets the state; the next pose initialises again from the buffered samples") {
+TEST_CASE("reset forgets the state, the next pose initialises again from the buffered samples") {
   Running r;
   Predictor& p = r.predictor;
   p.reset();
@@ -221,7 +221,7 @@ TEST_CASE("invalid options are refused with the field's name") {
   CHECK_FALSE(Predictor::create(o));
 }
 
-TEST_CASE("a wild IMU stamp is rejected as a time jump; a stream that stays there restarts the filter") {
+TEST_CASE("a wild IMU stamp is rejected as a time jump, a stream that stays there restarts the filter") {
   Running r;
   Predictor& p = r.predictor;
   const ImuSample last = r.imu.samples[r.next - 1];

@@ -141,7 +141,7 @@ TEST_CASE("predict follows the truth between samples and beyond the newest, with
   CHECK(near->extrapolated_s == Approx(0.001));
 }
 
-TEST_CASE("a pose ahead of the newest sample is applied there; older samples are then rejected") {
+TEST_CASE("a pose ahead of the newest sample is applied there, older samples are then rejected") {
   const Trajectory traj;
   const ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 1.0, 41);
   auto predictor = Predictor::create(PredictorOptions{});

@@ -56,7 +56,7 @@ TEST_CASE("joint rates: a joint slower than commanded pulls the estimate toward 
   CHECK(e.correction().isZero());
 }
 
-TEST_CASE("joint rates: a command older than the last is ignored; the store wraps without losing the newest",
+TEST_CASE("joint rates: a command older than the last is ignored, the store wraps without losing the newest",
           "[head][joint_rates]") {
   JointRateEstimate e(options());
   for (int i = 0; i < 200; ++i) e.sent(i * 0.001, {static_cast<double>(i), 0});

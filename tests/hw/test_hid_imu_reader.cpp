@@ -54,7 +54,7 @@ TEST_CASE("HID reports decode into samples with the device stamp and the host re
   CHECK(rig.reader->stats().samples == 1);
 }
 
-TEST_CASE("counter gaps count lost samples across the 8-bit wrap; repeats are dropped", "[hw][hid]") {
+TEST_CASE("counter gaps count lost samples across the 8-bit wrap, repeats are dropped", "[hw][hid]") {
   Rig rig;
   for (int c : {254, 255, 2, 2, 3}) rig.hid.reports.push_back(report(static_cast<std::uint8_t>(c), 0, 0));
   ImuReading reading;

@@ -52,6 +52,39 @@ TEST_CASE("opening sets up a non-blocking socket with filters, error frames, sta
   CHECK(kernel.closed == 1);
 }
 
+TEST_CASE("the receive queue is sized for stalls: forced when allowed, else the capped plain size",
+          "[hw][socketcan]") {
+  FakeCanKernel privileged, unprivileged, kernel_default;  // outlive the buses that use them
+  auto forced = open_fake(privileged);
+  CHECK(option_value<int>(privileged, SO_RCVBUFFORCE) == 1 << 20);
+  CHECK(privileged.options.count(SO_RCVBUF) == 0);
+
+  unprivileged.setsockopt_errno[SO_RCVBUFFORCE] = EPERM;
+  SocketCanOptions options;
+  options.receive_buffer_bytes = 300000;
+  auto capped = open_fake(unprivileged, options);
+  CHECK(option_value<int>(unprivileged, SO_RCVBUF) == 300000);
+
+  options.receive_buffer_bytes = 0;
+  auto untouched = open_fake(kernel_default, options);
+  CHECK(kernel_default.options.count(SO_RCVBUFFORCE) == 0);
+  CHECK(kernel_default.options.count(SO_RCVBUF) == 0);
+
+  FakeCanKernel refused;
+  refused.setsockopt_errno[SO_RCVBUFFORCE] = EPERM;
+  refused.setsockopt_errno[SO_RCVBUF] = ENOMEM;
+  auto r = SocketCanBus::open({}, refused);
+  REQUIRE_FALSE(r);
+  CHECK_THAT(r.error(), Catch::Contains("'can0'") && Catch::Contains("receive queue"));
+  CHECK(refused.closed == 1);
+
+  options.receive_buffer_bytes = -1;
+  FakeCanKernel unused;
+  r = SocketCanBus::open(options, unused);
+  REQUIRE_FALSE(r);
+  CHECK_THAT(r.error(), Catch::Contains("receive_buffer_bytes"));
+}
+
 TEST_CASE("each set-up failure names the interface and the step, and closes the socket", "[hw][socketcan]") {
   FakeCanKernel no_can;
   no_can.socket_errno = EAFNOSUPPORT;
@@ -137,7 +170,7 @@ TEST_CASE("the kernel's drop counter adds up across frames, also when it wraps",
   CHECK(bus->stats().rx_dropped == 10 + (0xFFFFFFFFull - 10) + 5);
 }
 
-TEST_CASE("a malformed read is counted and skipped; the next frame still arrives", "[hw][socketcan]") {
+TEST_CASE("a malformed read is counted and skipped, the next frame still arrives", "[hw][socketcan]") {
   FakeCanKernel kernel;
   auto bus = open_fake(kernel);
   kernel.push(0x1, {});
@@ -149,7 +182,7 @@ TEST_CASE("a malformed read is counted and skipped; the next frame still arrives
   CHECK(bus->stats().rx_malformed == 1);
 }
 
-TEST_CASE("a failing socket returns Error with the reason; EAGAIN is a timeout", "[hw][socketcan]") {
+TEST_CASE("a failing socket returns Error with the reason, EAGAIN is a timeout", "[hw][socketcan]") {
   FakeCanKernel kernel;
   auto bus = open_fake(kernel);
   StampedCanFrame got;
@@ -173,7 +206,7 @@ TEST_CASE("a socket that polls as failed but has nothing to read times out inste
   CHECK(kernel.polls >= 1);
 }
 
-TEST_CASE("sends write the kernel layout; refusals are counted with the reason", "[hw][socketcan]") {
+TEST_CASE("sends write the kernel layout, refusals are counted with the reason", "[hw][socketcan]") {
   FakeCanKernel kernel;
   auto bus = open_fake(kernel);
   CanFrame f;

@@ -65,7 +65,7 @@ TEST_CASE("an absent device or one that cannot capture fails with the device nam
   CHECK_THAT(camera.error(), Catch::Contains("not a single-planar video capture device"));
 }
 
-TEST_CASE("streamed frames carry the buffer's time stamp, sequence and pixels; buffers go back to the driver",
+TEST_CASE("streamed frames carry the buffer's time stamp, sequence and pixels, buffers go back to the driver",
           "[hw][v4l2]") {
   FakeClock clock;
   FakeV4l2Kernel kernel(clock);

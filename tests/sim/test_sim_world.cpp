@@ -196,7 +196,7 @@ TEST_CASE("world: IMU noise from the scenario shows in the decoded frames at its
   CHECK(std::sqrt(sum2 / n) == Approx(sigma).epsilon(0.08));
 }
 
-TEST_CASE("world: the head follows HeadCommand frames after the command latency; HeadState reports it at 200 Hz",
+TEST_CASE("world: the head follows HeadCommand frames after the command latency, HeadState reports it at 200 Hz",
           "[sim][world]") {
   auto world = make_world(scenario("command_latency_us 800\nhead_backlash_rad 0\nhead_accel_limit_radps2 100000\n"));
   const HeadAngles start = start_angles(*world);
@@ -328,7 +328,7 @@ TEST_CASE("world: a closed-loop run is deterministic for a seed (bus bytes, stam
   CHECK(differs);
 }
 
-TEST_CASE("world: time only moves forward, within the horizon; truth only within its history", "[sim][world]") {
+TEST_CASE("world: time only moves forward, within the horizon, truth only within its history", "[sim][world]") {
   auto world = make_world(scenario(""));
   REQUIRE(world->advance_to(0.5));
   auto back = world->advance_to(0.4);
@@ -358,7 +358,7 @@ TEST_CASE("world: time only moves forward, within the horizon; truth only within
   CHECK(w.error().find("camera_downscale") != std::string::npos);
 }
 
-TEST_CASE("world: both nodes answer a time-sync request with their own clocks; heartbeats come once a second",
+TEST_CASE("world: both nodes answer a time-sync request with their own clocks, heartbeats come once a second",
           "[sim][world]") {
   SimWorldOptions options;
   options.camera = CameraOutput::Blank;

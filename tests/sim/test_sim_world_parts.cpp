@@ -108,7 +108,7 @@ TEST_CASE("bus: node frames arrive after latency plus uniform jitter, in order, 
   CHECK(sum / static_cast<double>(delays_us.size()) == Approx(250).margin(3));
 }
 
-TEST_CASE("bus: a frame is not readable before it arrives; host frames reach the nodes after the command latency",
+TEST_CASE("bus: a frame is not readable before it arrives, host frames reach the nodes after the command latency",
           "[sim][bus]") {
   hw::FakeClock clock(1.0);
   const FaultPlan none;
@@ -241,7 +241,7 @@ TEST_CASE("head node: once the dead band is taken up the output moves with the m
   CHECK(still == 0);
 }
 
-TEST_CASE("head node: no command within the timeout stops the head with the timeout fault; a command resumes it",
+TEST_CASE("head node: no command within the timeout stops the head with the timeout fault, a command resumes it",
           "[sim][head]") {
   SimHeadNode node(ideal_dynamics(), 0.0, 0.0);
   double t = 0;
@@ -266,7 +266,7 @@ TEST_CASE("head node: no command within the timeout stops the head with the time
   CHECK(node.counters().commands_rejected == 1);
 }
 
-TEST_CASE("head node: a stuck joint does not move and reports over-current; it moves again when freed",
+TEST_CASE("head node: a stuck joint does not move and reports over-current, it moves again when freed",
           "[sim][head][fault]") {
   SimHeadNode node(ideal_dynamics(), 0.0, 0.0);
   double t = 0;

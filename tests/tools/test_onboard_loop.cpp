@@ -22,6 +22,7 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
+#include "sim_onboard_ports.h"
 
 using namespace epichead;
 namespace fw = epichead::firmware_iface;
@@ -65,11 +66,7 @@ Run run_loop(const std::string& extra, head::ControlMode mode, double seconds) {
   o.processing_s = 0.005;
   o.candump_path = dir / "bus.log";
   o.diagnostics_path = dir / "diagnostics.jsonl";
-  head::OnboardPorts ports;
-  ports.clock = &w.clock();
-  ports.bus = &w.bus();
-  ports.camera = &w.camera();
-  ports.wait_until = [&](double t_s) { return w.advance_to(t_s); };
+  const head::OnboardPorts ports = testing::sim_onboard_ports(w);
   auto loop = head::OnboardLoop::create(*model, w.camera_model(), o, ports);
   REQUIRE(loop);
   auto summary = (*loop)->run(seconds);
@@ -120,7 +117,7 @@ double commands_between(const Run& r, double t0, double t1) {
 
 }  // namespace
 
-TEST_CASE("onboard loop: an IMU dropout drops Stabilise to Hold; when samples return it stabilises again",
+TEST_CASE("onboard loop: an IMU dropout drops Stabilise to Hold, when samples return it stabilises again",
           "[tools][onboard][fault]") {
   const Run r = run_loop("fault imu_dropout 1.0 0.3\n", head::ControlMode::Stabilise, 2.0);
   INFO(r.diagnostics_text.substr(0, 3000));
@@ -141,7 +138,7 @@ TEST_CASE("onboard loop: an IMU dropout drops Stabilise to Hold; when samples re
   CHECK(commands_between(r, 1.05, 1.25) > 150);
 }
 
-TEST_CASE("onboard loop: bus-off withholds commands and holds; after the bus recovers commands resume from the measured state",
+TEST_CASE("onboard loop: bus-off withholds commands and holds, after the bus recovers commands resume from the measured state",
           "[tools][onboard][fault]") {
   const Run r = run_loop("fault bus_off 1.0 0.3\n", head::ControlMode::Stabilise, 2.0);
   INFO(r.diagnostics_text.substr(0, 3000));
@@ -159,7 +156,7 @@ TEST_CASE("onboard loop: bus-off withholds commands and holds; after the bus rec
   CHECK(commands_between(r, 1.5, 2.0) > 450);
 }
 
-TEST_CASE("onboard loop: a stuck joint does not wind up the command; the joint follows again when freed",
+TEST_CASE("onboard loop: a stuck joint does not wind up the command, the joint follows again when freed",
           "[tools][onboard][fault]") {
   const Run r = run_loop("fault stuck_joint tilt 0.2 0.6\n", head::ControlMode::Stabilise, 1.6);
   // The commanded tilt never runs further than max_following_error_rad (0.2 rad) from where the

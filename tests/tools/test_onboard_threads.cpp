@@ -10,12 +10,33 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
+#include "sim_onboard_ports.h"
 
 using namespace epichead;
 
 namespace {
 
-head::OnboardSummary run_mockup(head::VisionThreads threads, double seconds) {
+// A camera whose driver stamps each frame `ahead_s` after the loop's clock (vivid under load).
+class StampedAheadCamera final : public hw::CameraPort {
+ public:
+  StampedAheadCamera(hw::CameraPort& inner, double ahead_s) : inner_(inner), ahead_s_(ahead_s) {}
+  std::expected<void, std::string> start() override { return inner_.start(); }
+  void stop() override { inner_.stop(); }
+  hw::CameraRead next_frame(hw::CameraFrame& out, double timeout_s) override {
+    const hw::CameraRead r = inner_.next_frame(out, timeout_s);
+    if (r == hw::CameraRead::Frame) out.t_s += ahead_s_;
+    return r;
+  }
+  hw::CameraState state() const override { return inner_.state(); }
+  hw::CameraStats stats() const override { return inner_.stats(); }
+  std::string_view last_error() const override { return inner_.last_error(); }
+
+ private:
+  hw::CameraPort& inner_;
+  double ahead_s_;
+};
+
+head::OnboardSummary run_mockup(head::VisionThreads threads, double seconds, double camera_ahead_s = 0) {
   auto scenario = sim::find_scenario("mockup_walk");
   REQUIRE(scenario);
   sim::SimWorldOptions wo;
@@ -30,12 +51,10 @@ head::OnboardSummary run_mockup(head::VisionThreads threads, double seconds) {
   o.mode = head::ControlMode::Fixate;
   o.threads = threads;
   o.processing_s = 0.005;  // Inline only
-  head::OnboardPorts ports;
-  ports.clock = &w.clock();
-  ports.bus = &w.bus();
-  ports.camera = &w.camera();
   // Simulated time as fast as the control thread goes: it never waits for anything but itself.
-  ports.wait_until = [&](double t_s) { return w.advance_to(t_s); };
+  head::OnboardPorts ports = testing::sim_onboard_ports(w);
+  StampedAheadCamera ahead(w.camera(), camera_ahead_s);
+  if (camera_ahead_s > 0) ports.camera = &ahead;
   auto loop = head::OnboardLoop::create(*model, w.camera_model(), o, ports);
   REQUIRE(loop);
   auto truth = w.truth_at(w.now_s());
@@ -64,7 +83,7 @@ TEST_CASE("onboard loop (vision thread): the control loop ticks on while frames 
   CHECK(s.threads.find("vision:") != std::string::npos);
 }
 
-TEST_CASE("onboard loop (inline): a result is published processing_s after its frame; nothing is dropped",
+TEST_CASE("onboard loop (inline): a result is published processing_s after its frame, nothing is dropped",
           "[tools][onboard][threads]") {
   const head::OnboardSummary s = run_mockup(head::VisionThreads::Inline, 1.0);
   REQUIRE(s.frames >= 20);
@@ -73,4 +92,15 @@ TEST_CASE("onboard loop (inline): a result is published processing_s after its f
   CHECK(s.vision_latency_ms_median == Approx(s.frame_age_at_take_ms_median + 5.0).margin(1.01));
   CHECK(s.tick_lateness_us_max == 0);  // simulated time: a tick is never late
   CHECK(s.threads.find("inline") != std::string::npos);
+}
+
+TEST_CASE("onboard loop: frames stamped after the loop's clock are counted and taken as exposed when they arrived",
+          "[tools][onboard][threads]") {
+  const head::OnboardSummary s = run_mockup(head::VisionThreads::Inline, 0.5, 0.3);
+  REQUIRE(s.frames >= 8);  // a frame every 33 ms for 0.5 s
+  CHECK(s.frames_stamped_ahead >= s.frames);
+  // Exposure clamped to the moment the frame was taken: no negative ages or latencies.
+  CHECK(s.frame_age_at_take_ms_median == 0);
+  CHECK(s.vision_latency_ms_median == Approx(5.0).margin(1.01));
+  CHECK(s.tracked >= 1);
 }

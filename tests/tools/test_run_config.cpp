@@ -62,12 +62,34 @@ TEST_CASE("run config: an unknown gain, a gain out of range or of the wrong type
   CHECK(not_object.error().find("controller must be an object") != std::string::npos);
 }
 
+TEST_CASE("run config: the CAN interface and its receive queue, checked") {
+  TempDir dir;
+  const auto c = read_run_config(write_config(
+      dir, R"("can": { "interface": "vcan1", "receive_buffer_bytes": 4194304, "time_sync_max_round_trip_ms": 45 })"));
+  REQUIRE(c);
+  CHECK(c->time_sync_max_round_trip_s == Approx(0.045));
+  CHECK(c->can.interface == "vcan1");
+  CHECK(c->can.receive_buffer_bytes == 4194304);
+  const auto defaults = read_run_config(write_config(dir, R"("can": { "interface": "can2" })"));
+  REQUIRE(defaults);
+  CHECK(defaults->can.receive_buffer_bytes == epichead::hw::SocketCanOptions{}.receive_buffer_bytes);
+  const auto negative = read_run_config(write_config(dir, R"("can": { "receive_buffer_bytes": -5 })"));
+  REQUIRE_FALSE(negative);
+  CHECK(negative.error().find("can.receive_buffer_bytes") != std::string::npos);
+  const auto unsafe = read_run_config(write_config(dir, R"("can": { "time_sync_max_round_trip_ms": 70 })"));
+  REQUIRE_FALSE(unsafe);
+  CHECK(unsafe.error().find("can.time_sync_max_round_trip_ms") != std::string::npos);
+  const auto not_object = read_run_config(write_config(dir, R"("can": "vcan0")"));
+  REQUIRE_FALSE(not_object);
+  CHECK(not_object.error().find("can must be an object") != std::string::npos);
+}
+
 TEST_CASE("run --help lists the configuration keys and the controller's gains") {
   TempDir scratch;
   const auto r = epichead::testing::run_epichead(scratch, "run --help");
   CHECK(r.exit_code == 0);
   for (const char* key : {"camera_calibration", "init_pose", "pan_backlash_rad", "stabilise_gain_per_s", "fixate_gain_per_s",
-                          "rate_lead_s", "hold_max_rate_radps"})
+                          "rate_lead_s", "hold_max_rate_radps", "receive_buffer_bytes", "time_sync_max_round_trip_ms"})
     CHECK(r.out.find(key) != std::string::npos);
   // The defaults shown are the controller's own.
   CHECK(r.out.find("\"stabilise_gain_per_s\": 60") != std::string::npos);

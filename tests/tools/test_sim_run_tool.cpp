@@ -16,7 +16,7 @@ using epichead::testing::run_epichead;
 using epichead::testing::slurp;
 using epichead::testing::TempDir;
 
-TEST_CASE("sim-run: the stabilised camera turns several times slower than with the head fixed; the log replays",
+TEST_CASE("sim-run: the stabilised camera turns several times slower than with the head fixed, the log replays",
           "[tools][sim-run]") {
   TempDir dir("sim_run");
   // 2 s in stabilise mode at a small camera (vision is not used in that mode), two bursts.

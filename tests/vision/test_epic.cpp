@@ -90,7 +90,7 @@ Colour clutter_scene(double x, double) { return x > 60.0 ? kObject : (x > 52.0 ?
 
 }  // namespace
 
-TEST_CASE("EPIC returns the object edge beside a stronger clutter edge; gradient-only the clutter", "[epic]") {
+TEST_CASE("EPIC returns the object edge beside a stronger clutter edge, gradient-only the clutter", "[epic]") {
   const cv::Mat img = render(120, 120, clutter_scene, 1.0, 1.5);
   // Prediction 1.5 px off the true edge, between it and the clutter.
   const Eigen::Vector2d a(58.5, 20), b(58.5, 100);
@@ -200,7 +200,7 @@ TEST_CASE("sub-pixel accuracy is within 0.1 px on a clean blurred edge", "[epic]
   }
 }
 
-TEST_CASE("two close parallel edges with equal evidence yield two candidates; epic-single one", "[epic]") {
+TEST_CASE("two close parallel edges with equal evidence yield two candidates, epic-single one", "[epic]") {
   // Object side (Left = +x for a->b down) of the edge at x = 64 is 100, of the edge at x = 57 is
   // the 130 stripe: with a reference of 115 +- 20 both are equally likely object edges.
   const cv::Mat img = render(120, 120, [](double x, double) {
@@ -261,7 +261,7 @@ TEST_CASE("windows without edges or outside the image give no candidate and do n
   CHECK_FALSE(grad.result.found());
 }
 
-TEST_CASE("look-through keeps a contour with a thin printed border; without it EPIC takes the border's inner edge", "[epic]") {
+TEST_CASE("look-through keeps a contour with a thin printed border, without it EPIC takes the border's inner edge", "[epic]") {
   // A dark face (x > 63) with a 3 px lighter border strip (60 < x < 63) on a light background:
   // the model's contour is x = 60. The contour's edgels have the strip on their object side,
   // emptied by the edge margins, so without look-through they get no evidence (C = 0) and the

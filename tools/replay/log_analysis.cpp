@@ -54,7 +54,12 @@ void LogAnalyzer::add(const fw::CandumpRecord& r) {
   const std::uint64_t key = f.id | (static_cast<std::uint64_t>(f.extended() ? 1 : 0) << 32) |
                             (static_cast<std::uint64_t>(f.error() ? 1 : 0) << 33);
   auto it = ids_.find(key);
-  if (it == ids_.end() && ids_.size() < kMaxIds) it = ids_.emplace(key, IdStats{f.id, f.extended()}).first;
+  if (it == ids_.end() && ids_.size() < kMaxIds) {
+    IdStats fresh;
+    fresh.id = f.id;
+    fresh.extended = f.extended();
+    it = ids_.emplace(key, fresh).first;
+  }
   if (it != ids_.end()) {
     IdStats& s = it->second;
     s.timing.add(t_us, r.has_stamp, bus_s);

@@ -43,6 +43,10 @@ CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out);
 // The longest interface name Linux allows (IFNAMSIZ - 1); format_candump_line cuts longer ones.
 inline constexpr std::size_t kCandumpMaxIface = 15;
 
+// Why `iface` cannot be a log line's interface field (empty, a blank in it, longer than
+// kCandumpMaxIface), or nullptr when it can.
+const char* candump_iface_problem(std::string_view iface);
+
 namespace candump_detail {
 // Characters of "(sec.usec) " for the stamp with the longest seconds, negative included.
 constexpr std::size_t longest_stamp() {

@@ -55,6 +55,7 @@ enum class VisionThreads { Inline, Thread };
 struct OnboardOptions {
   double control_rate_hz = 1000;
   double time_sync_period_s = 0.1;
+  ClockSyncOptions imu_clock_sync;     // which time-sync replies are precise enough to map the IMU's clock
   double diagnostics_period_s = 0.1;
   VisionThreads threads = VisionThreads::Inline;
   RealtimeOptions realtime;
@@ -87,6 +88,7 @@ struct OnboardSummary {
   std::uint64_t commands_sent = 0, commands_withheld = 0, send_failures = 0;
   std::uint64_t bus_errors = 0, frames_logged = 0, unknown_frames = 0, undecodable_frames = 0;
   std::uint64_t camera_lost = 0, unreadable_frames = 0;  // device gone; frames of a format the tracker cannot read
+  std::uint64_t frames_stamped_ahead = 0;  // frames stamped after the loop's clock when taken: exposure taken as then
   double track_ms_median = 0, track_ms_p99 = 0;                 // wall time of the tracking step
   // Program clock. Exposure -> command = the frame's age when the loop takes it (half the
   // exposure, the camera's readout and transfer, up to one tick of polling) + processing + the
@@ -109,6 +111,7 @@ struct OnboardSummary {
   std::string threads;  // what each thread got: CPU, scheduling policy, memory lock
   HeadCounters controller;
   ImuAssemblyCounters imu_assembly;
+  ClockSyncCounters imu_clock;  // time sync with the IMU: without it no IMU sample can be placed in time
   fusion::PredictorCounters predictor;
 };
 

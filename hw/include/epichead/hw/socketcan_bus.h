@@ -1,7 +1,7 @@
 #pragma once
 // CanBus over Linux SocketCAN: a non-blocking CAN_RAW socket bound to one interface, with id
 // filters, error frames, kernel receive time stamps (SO_TIMESTAMP, wall clock in µs like
-// candump) and the kernel's drop counter (SO_RXQ_OVFL).
+// candump), the kernel's drop counter (SO_RXQ_OVFL) and a receive queue sized for stalls.
 #include <expected>
 #include <memory>
 #include <string>
@@ -19,6 +19,11 @@ struct SocketCanOptions {
   std::vector<CanIdFilter> filters;     // empty: receive every frame
   bool error_frames = true;             // subscribe to all error classes (bus-off, passive, ...)
   bool fd_frames = false;               // also receive and allow sending CAN FD frames
+  // The kernel's receive queue. Its default (net.core.rmem_default, about 200 KiB: some 250
+  // frames) bridges only ~0.1 s at the IMU's 2000 frames/s when the reader stalls. Asked with
+  // SO_RCVBUFFORCE (CAP_NET_ADMIN), else SO_RCVBUF, which the kernel caps at
+  // net.core.rmem_max. 0 keeps the kernel's default.
+  int receive_buffer_bytes = 1 << 20;
 };
 
 class SocketCanBus final : public CanBus {

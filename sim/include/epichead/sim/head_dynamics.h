@@ -1,6 +1,7 @@
 #pragma once
 // How the simulated pan/tilt head's firmware and motors move the joints (scenario keys
 // head_time_constant_s, head_rate_limit_radps, head_accel_limit_radps2, head_backlash_rad,
+// head_friction_radps2, head_servo_rate_hz,
 // head_state_rate_hz, head_command_timeout_s). Defaults: a small geared servo head whose
 // physical limits lie above the controller's own (head/joint_limits.h: 6 rad/s, 60 rad/s^2,
 // pan +-170 deg, tilt +-60 deg), so the controller's limits are the ones that act.
@@ -14,6 +15,7 @@ struct HeadDynamics {
   double rate_limit_radps = 8;        // motor speed limit
   double accel_limit_radps2 = 200;    // motor torque limit, as an acceleration
   double backlash_rad = 0.0005;       // gear dead band: output lags the motor this much on reversal
+  double friction_radps2 = 0;         // Coulomb friction as a deceleration against the motion (stiction at rest)
   double pan_min_rad = -3.0, pan_max_rad = 3.0;    // end stops
   double tilt_min_rad = -1.1, tilt_max_rad = 1.1;
   double state_rate_hz = 200;         // HeadState frames
