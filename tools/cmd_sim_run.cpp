@@ -4,15 +4,20 @@
 // Prints a summary and writes DIR/summary.json, DIR/bus.log (candump; `epichead replay` reads
 // it), DIR/diagnostics.jsonl, DIR/timeline.csv (the truth every millisecond: what the head
 // really did, for tuning and for finding where a residual camera rate comes from),
-// DIR/overlay_NNNNNN.png and DIR/*.png plots.
+// DIR/overlay_NNNNNN.png and DIR/*.png plots. With --soak: only the closed run, for a long
+// time, with memory and the predictor's attitude error watched (no bus log, timeline or plots,
+// whose growth would hide the loop's).
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -20,6 +25,7 @@
 
 #include "command.h"
 #include "onboard_summary_json.h"
+#include "process_memory.h"
 #include "plot/line_plot.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/head/target_observation.h"
@@ -44,6 +50,8 @@ struct SimRunArgs {
   double jerk = -1;
   double settle_s = 2.0;
   double told_backlash_rad = -1;  // < 0: the controller is told the scenario's true backlash
+  bool soak = false;              // the closed run alone, watched for memory growth and attitude drift
+  double soak_warmup_s = 60;
   std::string threads = "simulated";  // simulated (deterministic) | wall (vision on its own thread, as on the robot)
 };
 
@@ -56,6 +64,12 @@ struct RunMeasures {
   plot::Series rate_xy{"camera rate |x,y| (deg/s)", {}, {}};
   plot::Series pan{"pan (deg)", {}, {}}, tilt{"tilt (deg)", {}, {}};
   plot::Series centring{"target from centre (px)", {}, {}};
+  // --soak: resident memory (KiB) once warmed up, at the end and at most (sampled every 10 s of
+  // simulated time inside the run; the end is the last such sample), and the predictor's
+  // attitude error at each frame's exposure (t_s, deg).
+  double rss_warm_kib = 0, rss_end_kib = 0, rss_max_kib = 0;
+  std::vector<std::pair<double, double>> attitude_error_deg;  // sized (and touched) before the run
+  std::size_t attitude_errors = 0;                            // entries filled
 };
 
 // One frame's overlay PNG: the model at the tracker's pose, captioned. Returns whether it was written.
@@ -99,7 +113,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   const bool wall = a.threads == "wall";
   if (wall) o.threads = head::VisionThreads::Thread;  // processing_s is then what tracking really takes
   if (render) {
-    o.candump_path = (fs::path(out) / "bus.log").string();
+    if (!a.soak) o.candump_path = (fs::path(out) / "bus.log").string();
     o.diagnostics_path = (fs::path(out) / "diagnostics.jsonl").string();
   }
   // The truth is sampled every millisecond as simulated time advances.
@@ -112,7 +126,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   double sq_centre = 0;
   long centre_n = 0;
   std::ofstream timeline;
-  if (render) {
+  if (render && !a.soak) {
     timeline.open(fs::path(out) / "timeline.csv");
     if (!timeline) return std::unexpected("cannot write " + (fs::path(out) / "timeline.csv").string());
     timeline << "t_s,cam_rate_x_degps,cam_rate_y_degps,cam_rate_z_degps,pan_deg,tilt_deg,pan_rate_degps,tilt_rate_degps,"
@@ -155,7 +169,15 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
                     truth->joints.tilt_rate_radps * deg, off.x(), off.y());
       timeline << row;
     }
-    if (samples % 10 == 0) {  // plots at 100 Hz
+    if (a.soak) {
+      const long ms = std::lround(t_s * 1e3);
+      if (ms % 10000 == 0 || (m.rss_warm_kib == 0 && t_s >= a.soak_warmup_s)) {
+        const double rss = resident_kib().value_or(0);
+        m.rss_max_kib = std::max(m.rss_max_kib, rss);
+        m.rss_end_kib = rss;  // the last sample inside the run: the summary's own copies come after
+        if (m.rss_warm_kib == 0 && t_s >= a.soak_warmup_s) m.rss_warm_kib = rss;
+      }
+    } else if (samples % 10 == 0) {  // plots at 100 Hz
       m.rate_xy.x.push_back(t_s);
       m.rate_xy.y.push_back(std::hypot(r.x(), r.y()));
       m.pan.x.push_back(t_s);
@@ -178,7 +200,17 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   (*loop)->set_initial_pose(w.now_s(), init);
 
   int overlays = 0;
+  const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
+  // Sized up front (so its pages are resident before the baseline): the measuring must not grow.
+  if (a.soak) m.attitude_error_deg.assign(static_cast<std::size_t>(until * scenario.fps) + 16, {0.0, 0.0});
   const head::FrameHook hook = [&](const head::TrackedFrame& f) {
+    if (a.soak) {
+      if (auto truth = w.truth_at(f.exposure_t_s)) {
+        const Eigen::Matrix3d d = f.predicted_cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
+        if (m.attitude_errors < m.attitude_error_deg.size())
+          m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
+      }
+    }
     if (f.report->status != vision::TrackStatus::Lost) {
       auto truth = w.truth_at(f.exposure_t_s);
       if (truth) {
@@ -192,13 +224,58 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
     overlays += write_overlay(f, *model, cam, out);
   };
-  const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
   auto summary = (*loop)->run(std::min(until, w.horizon_s()), hook);
   if (!summary) return summary;
+  m.attitude_error_deg.resize(m.attitude_errors);
+
   m.cam_rate_rms_degps = samples ? std::sqrt(sq_xy / static_cast<double>(samples)) : 0;
   m.cam_rate_rms_all_degps = samples ? std::sqrt(sq_all / static_cast<double>(samples)) : 0;
   m.centring_rms_px = centre_n ? std::sqrt(sq_centre / static_cast<double>(centre_n)) : 0;
   return summary;
+}
+
+// Median of the attitude errors with t_s in [t0, t1), or -1 when there are none.
+double median_error_deg(const std::vector<std::pair<double, double>>& errors, double t0, double t1) {
+  std::vector<double> v;
+  for (const auto& [t, e] : errors)
+    if (t >= t0 && t < t1) v.push_back(e);
+  if (v.empty()) return -1;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// --soak: memory after warm-up and at the end, the predictor's attitude error early and late,
+// the loop's summary (faults and recoveries are in diagnostics.jsonl's events).
+int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::OnboardSummary& run, const RunMeasures& m) {
+  const double end_s = m.attitude_error_deg.empty() ? 0 : m.attitude_error_deg.back().first;
+  const double window_s = std::max(1.0, 0.1 * (end_s - a.soak_warmup_s));
+  const double early = median_error_deg(m.attitude_error_deg, a.soak_warmup_s, a.soak_warmup_s + window_s);
+  const double late = median_error_deg(m.attitude_error_deg, end_s - window_s, end_s + 1);
+  const nlohmann::json j{{"scenario", scenario.name},
+                         {"mode", a.mode},
+                         {"seed", scenario.seed},
+                         {"soak", {{"warmup_s", a.soak_warmup_s},
+                                   {"end_s", end_s},
+                                   {"rss_kib_after_warmup", m.rss_warm_kib},
+                                   {"rss_kib_end", m.rss_end_kib},
+                                   {"rss_kib_max", m.rss_max_kib},
+                                   {"attitude_window_s", window_s},
+                                   {"predicted_attitude_error_deg_median_early", early},
+                                   {"predicted_attitude_error_deg_median_late", late},
+                                   {"frames", m.frames}}},
+                         {"loop", summary_json(run)}};
+  const std::string summary_path = (fs::path(a.out) / "summary.json").string();
+  std::ofstream(summary_path) << j.dump(1) << '\n';
+  std::printf("sim-run %s --soak (%s, seed %llu): %.0f s simulated, %d frames (%llu tracked, %llu lost)\n",
+              scenario.name.c_str(), a.mode.c_str(), static_cast<unsigned long long>(scenario.seed), end_s, m.frames,
+              static_cast<unsigned long long>(run.tracked), static_cast<unsigned long long>(run.lost));
+  std::printf("  memory: %.0f KiB resident after %.0f s, %.0f KiB at the end, %.0f KiB at most\n", m.rss_warm_kib,
+              a.soak_warmup_s, m.rss_end_kib, m.rss_max_kib);
+  std::printf("  predicted attitude error at exposure: %.3f deg median over the first %.0f s after warm-up, %.3f deg over "
+              "the last %.0f s\n",
+              early, window_s, late, window_s);
+  std::printf("  wrote %s and %s\n", summary_path.c_str(), (fs::path(a.out) / "diagnostics.jsonl").c_str());
+  return 0;
 }
 
 int run_sim_run(const SimRunArgs& a) {
@@ -209,7 +286,11 @@ int run_sim_run(const SimRunArgs& a) {
   if (mode == modes.end()) return fail(cmd, "--mode must be fixate, stabilise or hold, got '" + a.mode + "'");
   auto scenario = sim::find_scenario(a.scenario);
   if (!scenario) return fail(cmd, scenario.error());
-  if (a.seed >= 0) scenario->seed = static_cast<std::uint64_t>(a.seed);
+  if (a.seed >= 0) {
+    // The seed draws the body's motion too (each step's burst, the hand's sway), not only the
+    // sensors' noise: otherwise every seed would walk the same steps.
+    scenario->seed = scenario->walking.seed = scenario->handheld.seed = static_cast<std::uint64_t>(a.seed);
+  }
   if (a.jerk >= 0) scenario->walking.jerk = a.jerk;
   std::error_code ec;
   fs::create_directories(a.out, ec);
@@ -218,6 +299,7 @@ int run_sim_run(const SimRunArgs& a) {
   RunMeasures closed, fixed, stabilised;
   auto run = run_once(*scenario, a, mode->second, true, a.out, closed);
   if (!run) return fail(cmd, run.error());
+  if (a.soak) return report_soak(*scenario, a, *run, closed);
   // Fixation turns the camera on purpose (toward the target); the stabilisation figure comes
   // from a run in stabilise mode (blank camera: that mode does not use vision).
   const bool fixating = mode->second == head::ControlMode::Fixate;
@@ -308,13 +390,18 @@ const CommandRegistration registration{
       app.add_option("--every", a->every, "Overlay every N tracked frames (0: none)")->check(CLI::Range(0, 1000000));
       app.add_option("--downscale", a->downscale, "Render a smaller camera: 1, 2, 4 or 8")->check(CLI::IsMember({1, 2, 4, 8}));
       app.add_option("--processing-ms", a->processing_ms, "Modelled vision processing time (default 5)")->check(CLI::Range(0.0, 1000.0));
-      app.add_option("--seed", a->seed, "Override the scenario's seed");
+      app.add_option("--seed", a->seed, "Override the scenario's seed (the sensors' noise and the body's steps)");
       app.add_option("--jerk", a->jerk, "Override the walking motion's jerk scale")->check(CLI::Range(0.0, 100.0));
       app.add_option("--threads", a->threads,
                      "simulated: vision inline, results published after --processing-ms of simulated time (deterministic, "
                      "default); wall: vision and recording on threads of their own in real time, as on the robot")
           ->check(CLI::IsMember({"simulated", "wall"}));
       app.add_option("--settle-s", a->settle_s, "Leave the first S seconds (the first slew) out of the rate RMS (default 2)")
+          ->check(CLI::Range(0.0, 1e6));
+      app.add_flag("--soak", a->soak,
+                   "Soak run: the closed run alone (no comparison runs, bus log, timeline or plots), reporting resident "
+                   "memory after --soak-warmup-s and at the end and the predictor's attitude error early and late");
+      app.add_option("--soak-warmup-s", a->soak_warmup_s, "Warm-up before the soak's memory baseline (default 60)")
           ->check(CLI::Range(0.0, 1e6));
       app.add_option("--told-backlash-rad", a->told_backlash_rad,
                      "The gear backlash the controller is told (default: the scenario's true head_backlash_rad; 0: none)")
