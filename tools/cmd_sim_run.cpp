@@ -266,6 +266,11 @@ int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::
                          {"loop", summary_json(run)}};
   const std::string summary_path = (fs::path(a.out) / "summary.json").string();
   std::ofstream(summary_path) << j.dump(1) << '\n';
+  // The error at every frame, for finding when and how it grew.
+  const std::string errors_path = (fs::path(a.out) / "attitude_error.csv").string();
+  std::ofstream errors(errors_path);
+  errors << "t_s,predicted_attitude_error_deg\n";
+  for (const auto& [t, e] : m.attitude_error_deg) errors << t << ',' << e << '\n';
   std::printf("sim-run %s --soak (%s, seed %llu): %.0f s simulated, %d frames (%llu tracked, %llu lost)\n",
               scenario.name.c_str(), a.mode.c_str(), static_cast<unsigned long long>(scenario.seed), end_s, m.frames,
               static_cast<unsigned long long>(run.tracked), static_cast<unsigned long long>(run.lost));
@@ -274,7 +279,8 @@ int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::
   std::printf("  predicted attitude error at exposure: %.3f deg median over the first %.0f s after warm-up, %.3f deg over "
               "the last %.0f s\n",
               early, window_s, late, window_s);
-  std::printf("  wrote %s and %s\n", summary_path.c_str(), (fs::path(a.out) / "diagnostics.jsonl").c_str());
+  std::printf("  wrote %s, %s and %s\n", summary_path.c_str(), errors_path.c_str(),
+              (fs::path(a.out) / "diagnostics.jsonl").c_str());
   return 0;
 }
 
