@@ -6,8 +6,7 @@
 // the same interface talks to devices that behave like the robot's, e.g. over vcan in the VM
 // test (tests/vm, docs/vm.md). The camera is not simulated here (run uses a V4L2 device).
 // Says "running" once on the bus; runs for --seconds or until SIGINT/SIGTERM; prints one summary
-// line either way and exits
-// non-zero when the interface fails.
+// line either way and exits non-zero when the interface fails.
 #include <CLI/CLI.hpp>
 
 #include <time.h>

@@ -7,7 +7,6 @@
 #include "epichead/firmware_iface/head_state.h"
 #include "epichead/firmware_iface/head_status.h"
 #include "epichead/firmware_iface/heartbeat.h"
-#include "epichead/firmware_iface/version.h"
 #include "node_heartbeat.h"
 
 namespace epichead::sim {

@@ -6,7 +6,6 @@
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/heartbeat.h"
 #include "epichead/firmware_iface/imu_frames.h"
-#include "epichead/firmware_iface/version.h"
 #include "node_heartbeat.h"
 #include "saturate.h"
 

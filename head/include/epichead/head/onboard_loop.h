@@ -55,7 +55,9 @@ enum class VisionThreads { Inline, Thread };
 struct OnboardOptions {
   double control_rate_hz = 1000;
   double time_sync_period_s = 0.1;
-  ClockSyncOptions imu_clock_sync;     // which time-sync replies are precise enough to map the IMU's clock
+  // Which time-sync replies are precise enough to map the IMU's clock. Its read_resolution_s is
+  // the loop's own (one control period: the bus is read once a tick) and is set by the loop.
+  ClockSyncOptions imu_clock_sync;
   double diagnostics_period_s = 0.1;
   VisionThreads threads = VisionThreads::Inline;
   RealtimeOptions realtime;
