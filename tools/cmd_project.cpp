@@ -31,6 +31,8 @@ int run_project(const std::string& seq_dir, int frame, const std::string& out_pa
   for (const auto& p : seq->ground_truth()) {
     if (p.frame == frame_number) { cam_T_obj = p.cam_T_obj; pose_source = "gt.csv"; found = true; break; }
   }
+  if (!found && !seq->has_init())
+    return fail("project", "no gt.csv pose for frame " + std::to_string(frame_number) + " and no init.csv");
   if (!found && seq->init().frame != frame_number)
     std::cerr << "epichead project: note: no gt.csv pose for frame " << frame_number
               << "; drawing the init.csv pose of frame " << seq->init().frame << "\n";

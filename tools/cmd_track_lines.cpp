@@ -127,6 +127,7 @@ int run_track_lines(const std::string& seq_dir, const std::string& out_dir, cons
   if (rim_side == rim_sides.end())
     return fail(cmd, "--rim-side must be inside, outside or both, got '" + rim_side_name + "'");
   auto seq = Sequence::open(seq_dir);
+  if (seq && !seq->has_init()) return fail(cmd, seq_dir + "/init.csv: missing (track-lines starts from it; `epichead detect` finds one)");
   if (!seq) return fail(cmd, seq.error());
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);

@@ -216,9 +216,12 @@ TEST_CASE("malformed sequence files give file:line errors") {
     dir.write("init.csv", "frame,t_s,tx,ty,tz,qw,qx,qy,qz\n0,0,0,0,1,1,0,0,0\n1,0.1,0,0,1,1,0,0,0\n");
     CHECK(open_error(dir) == d + "/init.csv: expected exactly one pose row, got 2");
   }
-  SECTION("missing init.csv") {
+  SECTION("missing init.csv: the sequence opens without a starting pose (detection finds it)") {
     fs::remove(dir.path / "init.csv");
-    CHECK(open_error(dir) == d + "/init.csv: cannot open");
+    auto seq = Sequence::open(d);
+    REQUIRE(seq);
+    CHECK_FALSE(seq->has_init());
+    CHECK(seq->init().frame == -1);
   }
   SECTION("missing camera.yaml") {
     fs::remove(dir.path / "camera.yaml");

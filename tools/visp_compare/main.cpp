@@ -57,6 +57,7 @@ int run(const Options& options) {
   cv::setNumThreads(1);
   auto seq = vision::Sequence::open(options.seq_dir);
   if (!seq) return fail(seq.error());
+  if (!seq->has_init()) return fail(options.seq_dir + "/init.csv: missing (ViSP's tracker starts from it)");
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
   if (ec) return fail(options.out_dir + ": cannot create: " + ec.message());

@@ -71,11 +71,15 @@ std::expected<Sequence, std::string> Sequence::open(const std::string& dir) {
   if (!model) return Error(model.error());
   seq.model_ = std::move(*model);
 
-  auto init = read_pose_csv(base + "init.csv");
-  if (!init) return Error(init.error());
-  if (init->size() != 1)
-    return Error(base + "init.csv: expected exactly one pose row, got " + std::to_string(init->size()));
-  seq.init_ = init->front();
+  // Without init.csv the tracker finds the object itself (detector.h).
+  if (is_file(base + "init.csv")) {
+    auto init = read_pose_csv(base + "init.csv");
+    if (!init) return Error(init.error());
+    if (init->size() != 1)
+      return Error(base + "init.csv: expected exactly one pose row, got " + std::to_string(init->size()));
+    seq.init_ = init->front();
+    seq.has_init_ = true;
+  }
 
   if (is_file(base + "gt.csv")) {
     auto gt = read_pose_csv(base + "gt.csv");

@@ -1,6 +1,6 @@
 #pragma once
 // A sequence directory (DESIGN.md): camera.yaml, model.cao, frames (frames.csv + images, or
-// video.mp4), init.csv, optional imu.csv and gt.csv. Real and simulated sequences read alike.
+// video.mp4), optional init.csv (without it the object is detected), imu.csv and gt.csv. Real and simulated sequences read alike.
 #include <expected>
 #include <memory>
 #include <string>
@@ -37,7 +37,11 @@ class Sequence {
   const std::string& dir() const { return dir_; }
   const Camera& camera() const { return camera_; }
   const CadModel& model() const { return model_; }
+  // The starting pose from init.csv, or one the caller found (set_init); identity at frame -1
+  // when there is neither.
+  bool has_init() const { return has_init_; }
   const StampedPose& init() const { return init_; }
+  void set_init(const StampedPose& pose) { init_ = pose; has_init_ = true; }
   bool has_ground_truth() const { return !gt_.empty(); }
   const std::vector<StampedPose>& ground_truth() const { return gt_; }
   bool has_imu() const { return !imu_.empty(); }
@@ -59,7 +63,8 @@ class Sequence {
   std::string dir_;
   Camera camera_;
   CadModel model_;
-  StampedPose init_;
+  StampedPose init_{-1, 0.0, Eigen::Isometry3d::Identity(), ""};
+  bool has_init_ = false;
   std::vector<StampedPose> gt_;
   std::vector<ImuRecord> imu_;
   std::vector<FrameEntry> frames_;

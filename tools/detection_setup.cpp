@@ -1,0 +1,83 @@
+#include "detection_setup.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <unistd.h>
+
+namespace epichead::tools {
+
+void add_detection_options(CLI::App& app, DetectionArgs& a) {
+  app.add_option("--cache-dir", a.cache_dir,
+                 "Where detection templates are cached, per model and camera (default $EPICHEAD_CACHE_DIR, "
+                 "$XDG_CACHE_HOME/epichead or ~/.cache/epichead)");
+  app.add_flag("--no-cache", a.no_cache, "Build the detection templates without reading or writing the cache");
+  app.add_option("--object-up", a.object_up,
+                 "The object's up direction in its model frame, x,y,z: with the IMU, gravity then removes two of "
+                 "the three rotation degrees of freedom from the detection search");
+  app.add_option("--distance-m", a.options.min_distance_m, "Detection: the nearest object distance to search, m (default from the model's size)")
+      ->check(CLI::Range(0.0, 1e3));
+  app.add_option("--max-distance-m", a.options.max_distance_m, "Detection: the farthest object distance to search, m")
+      ->check(CLI::Range(0.0, 1e3));
+  app.add_option("--views", a.options.view_subdivisions,
+                 "Detection: view sphere subdivisions (1: 42 views, 2: 162, 3: 642)")
+      ->check(CLI::Range(0, 4));
+  app.add_option("--min-support", a.options.min_support,
+                 "Detection: share of the model's outline an image edge must support for a pose to count as found")
+      ->check(CLI::Range(0.0, 1.0));
+}
+
+std::expected<std::unique_ptr<vision::Detector>, std::string> make_detector(const std::string& command,
+                                                                            const vision::CadModel& model,
+                                                                            const vision::Camera& camera,
+                                                                            const DetectionArgs& args,
+                                                                            const vision::ModelTrackerOptions& tracking) {
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  int last_quarter = -1;
+  // On a terminal a running count; in a log a line per quarter.
+  const vision::Detector::Progress progress = [&](int done, int total) {
+    if (total <= 0) return;
+    if (tty) {
+      std::fprintf(stderr, "\repichead %s: building detection templates %d/%d", command.c_str(), done, total);
+      if (done == total) std::fputc('\n', stderr);
+    } else if (const int q = 4 * done / total; q != last_quarter) {
+      last_quarter = q;
+      std::fprintf(stderr, "epichead %s: building detection templates %d/%d\n", command.c_str(), done, total);
+    }
+  };
+  auto detector = vision::Detector::create(model, camera, args.options, tracking, args.no_cache ? "" : args.cache_dir, progress);
+  if (!detector) return detector;
+  for (const auto& w : (*detector)->warnings()) std::fprintf(stderr, "epichead %s: warning: %s\n", command.c_str(), w.c_str());
+  return detector;
+}
+
+std::expected<std::optional<Eigen::Vector3d>, std::string> object_up(const DetectionArgs& args) {
+  if (args.object_up.empty()) return std::optional<Eigen::Vector3d>{};
+  Eigen::Vector3d v;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(args.object_up);
+  if (!(in >> v.x() >> c1 >> v.y() >> c2 >> v.z()) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !v.allFinite() ||
+      v.norm() < 1e-9)
+    return std::unexpected("--object-up must be x,y,z, a non-zero direction, got '" + args.object_up + "'");
+  return std::optional<Eigen::Vector3d>{v.normalized()};
+}
+
+std::optional<Eigen::Vector3d> up_from_imu(const std::vector<vision::ImuRecord>& imu, double t_s, double window_s) {
+  const auto first = std::lower_bound(imu.begin(), imu.end(), t_s - window_s,
+                                      [](const vision::ImuRecord& r, double t) { return r.t_s < t; });
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (auto it = first; it != imu.end() && it->t_s <= t_s + window_s; ++it)
+    if (it->accel_mps2.allFinite()) {
+      sum += it->accel_mps2;
+      ++n;
+    }
+  if (n == 0 || sum.norm() / n < 1.0) return std::nullopt;
+  return sum.normalized();
+}
+
+}  // namespace epichead::tools

@@ -1,0 +1,119 @@
+#pragma once
+// Detection: the pose of the model in one frame from the CAD model and the camera alone, with
+// no starting pose and no training images. Templates of the model's visible edges are rendered
+// over a view sphere, in-plane turns and a distance range and matched by gradient orientation
+// (OpenCV contrib's LINE-2D, cv::linemod); every hypothesis is then refined by the tracker's
+// own machinery (settling pass, EPIC, robust pose) and verified by how much of the projected
+// model an image edge of the right orientation supports. The best verified pose wins.
+//
+// Templates depend only on the model, the camera and the options: building them takes seconds
+// to a minute, so they are cached on disk (template_cache.h) and read back in well under a second.
+#include <cstdint>
+#include <expected>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "epichead/vision/camera.h"
+#include "epichead/vision/cao_model.h"
+#include "epichead/vision/model_tracker.h"
+
+namespace epichead::vision {
+
+struct DetectorOptions {
+  // Views: the vertices of an icosahedron subdivided this many times (2: 162 directions,
+  // about 17 deg apart; 3: 642, about 8.5 deg).
+  int view_subdivisions = 2;
+  double in_plane_step_deg = 15.0;  // turns about the line of sight
+  // Distance range of the object's centre, m; 0 = from the model's size and the image: the
+  // object spans from min_span to max_span of the image's shorter side.
+  double min_distance_m = 0, max_distance_m = 0;
+  double min_span = 0.2, max_span = 0.9;
+  double distance_ratio = 1.2;  // between neighbouring template distances
+  int features_per_template = 63;
+  // With a known gravity direction: only views whose object up lies within this of the
+  // camera's up are matched (gravity from the accelerometer, the object's up from the model).
+  double up_tolerance_deg = 25.0;
+  // Hypotheses: LINE-2D matches at or above min_similarity (percent), the best max_hypotheses
+  // of them after suppressing neighbours (same place, near the same view) refined and verified.
+  float min_similarity = 75.0f;
+  int max_hypotheses = 48;
+  double duplicate_px = 8.0;  // hypotheses whose projected model points lie this close are one
+  int refine_passes = 8;  // tracking steps on the frame from each hypothesis
+  // A detection is reported found when at least this share of the projected model's edge
+  // samples has an image edge of its orientation within support_radius_px.
+  double min_support = 0.55;
+  double support_radius_px = 2.0;
+};
+
+// A pose found in one frame.
+struct DetectionHypothesis {
+  Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();  // after refinement
+  Eigen::Isometry3d start_cam_T_obj = Eigen::Isometry3d::Identity();  // the template's pose it started from
+  float similarity = 0;   // LINE-2D's, percent
+  double support = 0;     // share of projected edge samples with an image edge (0..1)
+  // What ranks hypotheses: support x supported samples. At the same share the pose that
+  // explains more outline wins, so a small outline matched on printed texture or clutter
+  // loses against the whole object.
+  double score = 0;
+  TrackStatus status = TrackStatus::Lost;  // of the last refinement step
+};
+
+struct DetectionResult {
+  bool found = false;
+  DetectionHypothesis best;
+  int templates_matched = 0;   // templates the gravity filter left
+  int matches = 0;             // LINE-2D matches above min_similarity
+  std::vector<DetectionHypothesis> hypotheses;  // every refined hypothesis, best score first
+  double match_ms = 0, refine_ms = 0;
+};
+
+// Where a detection search looks: everywhere, or near a predicted pose (re-acquisition).
+struct DetectionPrior {
+  std::optional<Eigen::Vector3d> up_cam;  // the world's up in the camera frame (unit)
+  std::optional<Eigen::Vector3d> up_obj;  // the object's up in its own frame (unit)
+  // Tried first as a hypothesis of its own (the tracker's last or predicted pose).
+  std::optional<Eigen::Isometry3d> near_cam_T_obj;
+};
+
+class Detector {
+ public:
+  // Progress while building templates: done and total template count.
+  using Progress = std::function<void(int done, int total)>;
+  // Reads the templates from `cache_dir` when a cache for this model, camera and options is
+  // there, else renders them (reporting progress) and writes the cache. An empty cache_dir
+  // neither reads nor writes. A cache that cannot be read is rebuilt, with a warning in
+  // warnings(); one that cannot be written is a warning too.
+  static std::expected<std::unique_ptr<Detector>, std::string> create(const CadModel& model, const Camera& camera,
+                                                                      const DetectorOptions& options,
+                                                                      const ModelTrackerOptions& tracking,
+                                                                      const std::string& cache_dir,
+                                                                      const Progress& progress = {});
+  ~Detector();
+
+  // Finds the model in `frame` (8-bit grey or BGR, the camera's size).
+  std::expected<DetectionResult, std::string> detect(const cv::Mat& frame, const DetectionPrior& prior = {});
+
+  int template_count() const;
+  bool loaded_from_cache() const;
+  const std::string& cache_path() const;
+  double build_s() const;  // time spent building or reading the templates
+  const std::vector<std::string>& warnings() const;
+
+ private:
+  struct Impl;
+  explicit Detector(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// The default directory of template caches: $EPICHEAD_CACHE_DIR, else $XDG_CACHE_HOME/epichead,
+// else ~/.cache/epichead; empty when none can be formed.
+std::string default_template_cache_dir();
+
+}  // namespace epichead::vision
