@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "command.h"
+#include "epichead/vision/offline/model_symmetry.h"
 #include "line_selection_score.h"
 #include "epichead/vision/offline/score.h"
 #include "epichead/vision/offline/sequence.h"
@@ -135,6 +136,7 @@ const CommandRegistration registration{
       auto reference = std::make_shared<std::string>();
       auto corners = std::make_shared<std::vector<std::string>>();
       auto lines = std::make_shared<std::string>();
+      auto symmetric = std::make_shared<bool>(false);
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
@@ -143,6 +145,9 @@ const CommandRegistration registration{
       app.add_option("--sym-axis", *axis_text,
                      "X,Y,Z: the object is symmetric about this axis through its origin (object frame); "
                      "the unobservable turn about it is removed before scoring");
+      app.add_flag("--symmetric", *symmetric,
+                   "Score up to the model's own symmetries (turns that map its points onto its points, e.g. a box's half "
+                   "turns): a pose found without a start (detect) may be any of them");
       app.add_option("--per-frame", *per_frame,
                      "Write frame,present,success,rotation_deg,translation_mm,reprojection_px to this CSV");
       app.add_option("--reference", *reference,
@@ -190,8 +195,10 @@ const CommandRegistration registration{
           return 0;
         }
 
+        const std::vector<Eigen::Isometry3d> symmetries =
+            *symmetric ? vision::model_symmetries(seq->model()) : std::vector<Eigen::Isometry3d>{};
         const ScoreSummary summary =
-            vision::score_poses(truth_poses, *estimates, seq->camera(), seq->model(), axis);
+            vision::score_poses(truth_poses, *estimates, seq->camera(), seq->model(), axis, {}, symmetries);
         nlohmann::json line_json = nullptr;
         if (!lines->empty()) {
           auto ls = score_line_selection(*lines, *seq, truth_poses);

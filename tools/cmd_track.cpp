@@ -24,6 +24,7 @@
 
 #include "command.h"
 #include "printable.h"
+#include "track_acquisition.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/overlay.h"
@@ -49,6 +50,7 @@ struct TrackArgs {
   std::string free_turn = "auto";
   bool settle = true;
   std::uint32_t ransac_seed = RansacOptions{}.seed;
+  AcquisitionOptions acquisition;
 };
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
@@ -267,7 +269,11 @@ int run_track(const TrackArgs& args) {
   if (!seq) return fail(cmd, seq.error());
   const auto offset = imu_time_offset(args.imu_time_offset);
   if (!offset) return fail(cmd, offset.error());
-  auto predictor = make_track_predictor(*seq, args.imu == "on", *offset);
+  if (args.imu == "on" && !seq->has_imu()) return fail(cmd, "--imu on: " + seq->dir() + " has no imu.csv");
+  if (const auto up = object_up(args.acquisition.detection); !up) return fail(cmd, up.error());
+  // Without init.csv the predictor is made once detection has found the start.
+  std::expected<std::unique_ptr<TrackPredictor>, std::string> predictor = std::unique_ptr<TrackPredictor>{};
+  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -277,6 +283,10 @@ int run_track(const TrackArgs& args) {
 
   const ModelTrackerOptions options = tracker_options(args, mode->second);
   ModelTracker tracker(seq->model(), seq->camera(), options);
+  AcquisitionOptions acquisition_options = args.acquisition;
+  acquisition_options.use_imu_gravity = args.imu == "on";
+  TrackAcquisition acquisition(*seq, options, acquisition_options);
+  int searched_frames = 0;
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
   WindowImage image;
@@ -302,9 +312,35 @@ int run_track(const TrackArgs& args) {
     if (!frame) return fail(cmd, frame.error());
     if (auto ok = image.assign(*frame); !ok) return fail(cmd, "frame " + std::to_string(i) + ": " + ok.error());
     const FrameEntry& entry = seq->frames()[i];
-    const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
+    if (!*predictor) {
+      // No start yet: detect in this frame; frames before the start have no pose.
+      const auto found = acquisition.find_start(*frame, entry.frame, entry.t_s);
+      if (!found) return fail(cmd, found.error());
+      if (!*found) {
+        ++searched_frames;
+        per_frame.push_back({{"frame", entry.frame}, {"t_s", entry.t_s}, {"status", "searching"}});
+        continue;
+      }
+      seq->set_init({entry.frame, entry.t_s, **found, ""});
+      predictor = make_track_predictor(*seq, args.imu == "on", *offset);
+      if (!predictor) return fail(cmd, predictor.error());
+      std::printf("frame %d: object detected; tracking from here\n", entry.frame);
+    }
+    Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
     const std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
+    if (acquisition.after_frame(report.status)) {
+      // Lost for a few frames: look for the object again, near the prediction first.
+      const auto found = acquisition.find_again(*frame, entry.frame, entry.t_s, predicted);
+      if (!found) return fail(cmd, found.error());
+      if (*found) {
+        tracker.reset();
+        (*predictor)->restart(entry.t_s, **found);
+        predicted = **found;
+        tracker.track(image, predicted, report);
+        report.reasons = report.reasons | TrackReason::Reacquired;
+      }
+    }
     fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
     track_ms.push_back(report.times.total_ms);
@@ -350,7 +386,9 @@ int run_track(const TrackArgs& args) {
   j["lost"] = lost;
   j["track_ms_median"] = percentile(track_ms, 0.5);
   j["track_ms_p99"] = percentile(track_ms, 0.99);
-  j["predictor"] = (*predictor)->diagnostics();
+  j["predictor"] = *predictor ? (*predictor)->diagnostics() : nlohmann::json(nullptr);
+  j["acquisition"] = acquisition.to_json();
+  j["searched_frames"] = searched_frames;  // frames before detection found the start
   j["fused_frames"] = fused_frames;
   j["fallback_frames"] = fallback_frames;  // frames measured from the vision-only extrapolation
   if (tracker.free_turn()) {
@@ -378,7 +416,10 @@ const CommandRegistration registration{
     "track", "Track the model over a sequence (EPIC, validation, robust pose) and write poses, report and overlays",
     [](CLI::App& app) {
       auto a = std::make_shared<TrackArgs>();
-      app.add_option("SEQ", a->seq, "Sequence directory (camera.yaml, model.cao, frames, init.csv[, imu.csv])")->required();
+      app.add_option("SEQ", a->seq,
+                     "Sequence directory (camera.yaml, model.cao, frames[, init.csv, imu.csv]); without init.csv the "
+                     "object is detected first")
+          ->required();
       app.add_option("--out", a->out, "Output directory: poses.csv, report.json, overlay_NNNNNN.png, overlay.mp4")->required();
       app.add_option("--mode", a->mode, "gradient | epic | epic+validation (default)");
       app.add_option("--imu", a->imu, "on: predict each frame's pose with the IMU (imu.csv); off: constant velocity (default)");
@@ -405,6 +446,13 @@ const CommandRegistration registration{
                    "gradient pass that settles the start before the cue references are learnt");
       app.add_option("--ransac-seed", a->ransac_seed,
                      "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");
+      app.add_flag("!--no-reacquire", a->acquisition.reacquire,
+                   "After a loss retry from the last pose only; by default detection looks for the object again once "
+                   "it has been lost for --reacquire-after frames");
+      app.add_option("--reacquire-after", a->acquisition.lost_frames_before_detection,
+                     "Lost frames in a row before detection runs (default 3)")
+          ->check(CLI::Range(1, 100000));
+      add_detection_options(app, a->acquisition.detection);
       return [a]() { return run_track(*a); };
     }};
 

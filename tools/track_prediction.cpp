@@ -28,6 +28,11 @@ class ConstantVelocityPredictor final : public TrackPredictor {
   // Starts from the given pose (init.csv) at rest.
   ConstantVelocityPredictor(double t_s, const Eigen::Isometry3d& cam_T_obj)
       : last_(cam_T_obj), last_tracked_(cam_T_obj), last_t_s_(t_s) {}
+  void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+    last_ = last_tracked_ = prev_ = cam_T_obj;
+    last_t_s_ = prev_t_s_ = t_s;
+    have_motion_ = false;
+  }
   Eigen::Isometry3d predict(double t_s) override {
     if (!have_motion_ || !(last_t_s_ > prev_t_s_)) return last_;
     const double s = (t_s - last_t_s_) / (last_t_s_ - prev_t_s_);
@@ -133,6 +138,18 @@ class ImuPredictor final : public TrackPredictor {
     return last_good_;
   }
   std::optional<Eigen::Isometry3d> fallback(double t_s) override { return vision_only_.predict(t_s); }
+  void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+    // The detected pose seeds the filter as init.csv's does; the next tracked pose at this
+    // time then replaces it (observe()).
+    predictor_.reset();
+    vision_only_.restart(t_s, cam_T_obj);
+    last_good_ = cam_T_obj;
+    last_good_t_s_ = init_t_s_ = t_s;
+    pending_init_ = true;
+    reset_done_ = false;
+    supported_gated_ = 0;
+    ++detection_restarts_;
+  }
   void observe(double t_s, const vision::FrameReport& report) override {
     vision_only_.observe(t_s, report);
     if (report.status == vision::TrackStatus::Lost) {
@@ -221,6 +238,7 @@ class ImuPredictor final : public TrackPredictor {
             {"restarts_from_fallback", fallback_restarts_},
             {"weak_poses_after_loss", weak_reacquisitions_},
             {"restarts_after_supported_gated", gated_restarts_},
+            {"restarts_from_detection", detection_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},
             {"lost_frames", lost_}};
@@ -290,7 +308,7 @@ class ImuPredictor final : public TrackPredictor {
   bool pending_init_ = false, reset_done_ = false;
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
-  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0;
+  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0, detection_restarts_ = 0;
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).

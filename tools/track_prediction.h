@@ -29,6 +29,9 @@ class TrackPredictor {
   // A second opinion for a frame the tracker loses from predict(t_s): the vision poses
   // extrapolated alone, when the predictor is more than that (the IMU); nothing otherwise.
   virtual std::optional<Eigen::Isometry3d> fallback(double t_s) { (void)t_s; return std::nullopt; }
+  // Detection found the object again at t_s (after a loss): predictions restart from this pose
+  // at rest, as from init.csv.
+  virtual void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) = 0;
   // Counters for report.json.
   virtual nlohmann::json diagnostics() const = 0;
 };

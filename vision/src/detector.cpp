@@ -410,6 +410,7 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
                            " but the calibration is " + std::to_string(d.camera.width_px()) + "x" +
                            std::to_string(d.camera.height_px()));
   DetectionResult result;
+  if (auto ok = d.window_image.assign(frame); !ok) return std::unexpected("detect: " + ok.error());
   const auto t0 = Clock::now();
   cv::Mat grey, bgr;
   if (frame.channels() == 1) {
@@ -418,6 +419,20 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   } else {
     bgr = frame;
     cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
+  }
+  d.gradients.compute(grey);
+  // Near the prediction first: when the object is where it was expected, no search is needed.
+  if (prior.near_cam_T_obj) {
+    const auto t_near = Clock::now();
+    DetectionHypothesis near = d.refine(*prior.near_cam_T_obj, 0.0f);
+    result.refine_ms += ms_since(t_near);
+    if (near.support >= d.options.min_support) {
+      result.best = near;
+      result.found = true;
+      result.hypotheses.push_back(near);
+      return result;
+    }
+    result.hypotheses.push_back(near);
   }
   const int pad_x = (kPadMultiple - bgr.cols % kPadMultiple) % kPadMultiple;
   const int pad_y = (kPadMultiple - bgr.rows % kPadMultiple) % kPadMultiple;
@@ -429,20 +444,14 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   if (!classes.empty()) d.line2d->match({bgr}, d.options.min_similarity, matches, classes);
   result.matches = static_cast<int>(matches.size());
   std::vector<float> similarity;
-  std::vector<Eigen::Isometry3d> starts = d.hypotheses(matches, prior, similarity);
-  if (prior.near_cam_T_obj) {
-    starts.insert(starts.begin(), *prior.near_cam_T_obj);
-    similarity.insert(similarity.begin(), 0.0f);
-  }
-  result.match_ms = ms_since(t0);
+  const std::vector<Eigen::Isometry3d> starts = d.hypotheses(matches, prior, similarity);
+  result.match_ms = ms_since(t0) - result.refine_ms;
 
   const auto t1 = Clock::now();
-  if (auto ok = d.window_image.assign(frame); !ok) return std::unexpected("detect: " + ok.error());
-  d.gradients.compute(grey);
   for (std::size_t i = 0; i < starts.size(); ++i) result.hypotheses.push_back(d.refine(starts[i], similarity[i]));
   std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(),
                    [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
-  result.refine_ms = ms_since(t1);
+  result.refine_ms += ms_since(t1);
   if (!result.hypotheses.empty()) {
     result.best = result.hypotheses.front();
     result.found = result.best.support >= d.options.min_support;

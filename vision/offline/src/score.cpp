@@ -89,7 +89,8 @@ ErrorStats stats_of(std::vector<double> values) {
 
 ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimates,
                          const Camera& camera, const CadModel& model,
-                         const std::optional<Eigen::Vector3d>& sym_axis_obj, const ScoreCriterion& criterion) {
+                         const std::optional<Eigen::Vector3d>& sym_axis_obj, const ScoreCriterion& criterion,
+                         const std::vector<Eigen::Isometry3d>& symmetries_obj) {
   std::optional<Eigen::Vector3d> axis;
   if (sym_axis_obj) {
     if (!sym_axis_obj->allFinite() || sym_axis_obj->norm() < 1e-12)
@@ -122,6 +123,10 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std
       s.present = true;
       Eigen::Isometry3d est_T = it->second->cam_T_obj;
       const Eigen::Matrix3d R_gt = gt->cam_T_obj.linear();
+      for (const auto& S : symmetries_obj) {
+        const Eigen::Isometry3d alt = it->second->cam_T_obj * S;
+        if (rotation_angle_deg(R_gt.transpose() * alt.linear()) < rotation_angle_deg(R_gt.transpose() * est_T.linear())) est_T = alt;
+      }
       if (axis) est_T.linear() = remove_turn(R_gt, est_T.linear(), *axis);
       s.rotation_deg = rotation_angle_deg(R_gt.transpose() * est_T.linear());
       const double translation_m = (est_T.translation() - gt->cam_T_obj.translation()).norm();

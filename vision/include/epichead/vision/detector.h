@@ -78,7 +78,8 @@ struct DetectionResult {
 struct DetectionPrior {
   std::optional<Eigen::Vector3d> up_cam;  // the world's up in the camera frame (unit)
   std::optional<Eigen::Vector3d> up_obj;  // the object's up in its own frame (unit)
-  // Tried first as a hypothesis of its own (the tracker's last or predicted pose).
+  // Refined and verified first (the tracker's last or predicted pose): when it is found there,
+  // the global search is skipped.
   std::optional<Eigen::Isometry3d> near_cam_T_obj;
 };
 

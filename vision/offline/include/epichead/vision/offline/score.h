@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
@@ -46,12 +47,15 @@ struct ScoreSummary {
 // Scores `estimates` against `ground_truth` frame by frame (matched on the frame column).
 // A ground-truth frame without an estimate, or whose estimate has status "lost", fails. With sym_axis_obj (a unit axis through the
 // object origin), the turn about it that makes the estimate closest to the truth is removed
-// first, since it is unobservable for a body of revolution.
+// first, since it is unobservable for a body of revolution. With symmetries_obj (object-frame
+// turns that leave the model's look unchanged, model_symmetry.h), the estimate composed with
+// whichever of them (or none) brings it closest to the truth is scored.
 ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth,
                          const std::vector<StampedPose>& estimates, const Camera& camera,
                          const CadModel& model,
                          const std::optional<Eigen::Vector3d>& sym_axis_obj = std::nullopt,
-                         const ScoreCriterion& criterion = {});
+                         const ScoreCriterion& criterion = {},
+                         const std::vector<Eigen::Isometry3d>& symmetries_obj = {});
 
 // A model point read by hand in an image (real video has no ground truth): X Y Z u v per line.
 struct CornerObservation {

@@ -1,0 +1,89 @@
+#include "track_acquisition.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace epichead::tools {
+
+TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
+                                   const AcquisitionOptions& options)
+    : seq_(&seq), tracking_(tracking), options_(options) {
+  if (auto up = object_up(options.detection); up) up_obj_ = *up;
+}
+
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::detect(
+    const cv::Mat& frame, double t_s, const std::optional<Eigen::Isometry3d>& near) {
+  if (!detector_) {
+    auto d = make_detector("track", seq_->model(), seq_->camera(), options_.detection, tracking_);
+    if (!d) return std::unexpected(d.error());
+    detector_ = std::move(*d);
+  }
+  vision::DetectionPrior prior;
+  prior.near_cam_T_obj = near;
+  if (options_.use_imu_gravity && up_obj_) {
+    prior.up_obj = up_obj_;
+    prior.up_cam = up_from_imu(seq_->imu(), t_s);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  auto r = detector_->detect(frame, prior);
+  detect_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  ++detections_;
+  if (!r) return std::unexpected(r.error());
+  if (!r->found) return std::optional<Eigen::Isometry3d>{};
+  return std::optional<Eigen::Isometry3d>{r->best.cam_T_obj};
+}
+
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_start(const cv::Mat& frame, int frame_number,
+                                                                                          double t_s) {
+  ++start_attempts_;
+  auto r = detect(frame, t_s, std::nullopt);
+  if (r && *r) start_frame_ = frame_number;
+  return r;
+}
+
+bool TrackAcquisition::after_frame(vision::TrackStatus status) {
+  if (status != vision::TrackStatus::Lost) {
+    lost_run_ = 0;
+    in_loss_ = false;
+    return false;
+  }
+  if (!in_loss_) ++losses_;
+  in_loss_ = true;
+  ++lost_run_;
+  return options_.reacquire && lost_run_ >= options_.lost_frames_before_detection;
+}
+
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_again(const cv::Mat& frame, int frame_number,
+                                                                                          double t_s,
+                                                                                          const Eigen::Isometry3d& predicted) {
+  (void)frame_number;
+  auto r = detect(frame, t_s, predicted);
+  if (r && *r) {
+    ++reacquired_;
+    frames_to_reacquire_.push_back(lost_run_);
+    lost_run_ = 0;
+    in_loss_ = false;
+  }
+  return r;
+}
+
+nlohmann::json TrackAcquisition::to_json() const {
+  std::vector<double> ms = detect_ms_;
+  std::sort(ms.begin(), ms.end());
+  nlohmann::json j = {{"start", start_frame_ >= 0 ? nlohmann::json{{"frame", start_frame_}, {"attempts", start_attempts_}}
+                                                  : nlohmann::json(nullptr)},
+                      {"losses", losses_},
+                      {"reacquisitions", reacquired_},
+                      {"frames_to_reacquire", frames_to_reacquire_},
+                      {"detections", detections_},
+                      {"detect_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},
+                      {"detect_ms_max", ms.empty() ? 0.0 : ms.back()}};
+  if (detector_) {
+    j["templates"] = detector_->template_count();
+    j["template_cache"] = detector_->cache_path();
+    j["templates_from_cache"] = detector_->loaded_from_cache();
+  }
+  return j;
+}
+
+}  // namespace epichead::tools

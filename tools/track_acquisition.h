@@ -1,0 +1,59 @@
+#pragma once
+// How `epichead track` finds the object without init.csv and after a loss: detection
+// (vision/detector.h) on the frame, near the predicted pose first and then over the whole
+// view sphere, and the counts report.json gives (losses, re-acquisitions, frames to re-acquire).
+// The detector is built on first need, so a run that never loses the object pays nothing.
+#include <expected>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "detection_setup.h"
+#include "epichead/vision/detector.h"
+#include "epichead/vision/model_tracker.h"
+#include "epichead/vision/offline/sequence.h"
+
+namespace epichead::tools {
+
+struct AcquisitionOptions {
+  DetectionArgs detection;
+  bool use_imu_gravity = false;      // gravity from imu.csv narrows the search (with --object-up)
+  bool reacquire = true;             // detect after a loss (false: retry from the last pose only)
+  int lost_frames_before_detection = 3;
+};
+
+class TrackAcquisition {
+ public:
+  TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking, const AcquisitionOptions& options);
+
+  // The start: the pose found in this frame, or nothing (the frame counts as searched).
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_start(const cv::Mat& frame, int frame_number, double t_s);
+  // After each tracked frame: the tracker's status. True when detection should run on this
+  // frame (lost for lost_frames_before_detection frames in a row, and re-acquisition on).
+  bool after_frame(vision::TrackStatus status);
+  // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, int frame_number, double t_s,
+                                                                          const Eigen::Isometry3d& predicted);
+  nlohmann::json to_json() const;
+
+ private:
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
+                                                                      const std::optional<Eigen::Isometry3d>& near);
+  const vision::Sequence* seq_;
+  vision::ModelTrackerOptions tracking_;
+  AcquisitionOptions options_;
+  std::optional<Eigen::Vector3d> up_obj_;
+  std::unique_ptr<vision::Detector> detector_;
+  int start_frame_ = -1, start_attempts_ = 0;
+  int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
+  bool in_loss_ = false;
+  std::vector<int> frames_to_reacquire_;
+  std::vector<double> detect_ms_;
+};
+
+}  // namespace epichead::tools
