@@ -98,6 +98,7 @@ int run_detect(const DetectArgs& a) {
     nlohmann::json e = pose_json(h.cam_T_obj);
     e["support"] = h.support;
     e["score"] = h.score;
+    e["supported_px"] = h.supported_px;
     e["similarity"] = h.similarity;
     e["status"] = to_string(h.status);
     e["start"] = pose_json(h.start_cam_T_obj);

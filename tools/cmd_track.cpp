@@ -341,6 +341,17 @@ int run_track(const TrackArgs& args) {
         report.reasons = report.reasons | TrackReason::Reacquired;
       }
     }
+    if (report.status != TrackStatus::Lost && acquisition.recheck_due(entry.t_s)) {
+      // A detected start is provisional: a pose that explains much more of the image takes over.
+      const auto better = acquisition.recheck(*frame, entry.t_s, report.cam_T_obj);
+      if (!better) return fail(cmd, better.error());
+      if (*better) {
+        tracker.reset();
+        (*predictor)->restart(entry.t_s, **better);
+        tracker.track(image, **better, report);
+        report.reasons = report.reasons | TrackReason::Reacquired;
+      }
+    }
     fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
     track_ms.push_back(report.times.total_ms);

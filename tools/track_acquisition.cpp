@@ -29,6 +29,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
   detect_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   ++detections_;
   if (!r) return std::unexpected(r.error());
+  last_score_ = r->best.score;
   if (!r->found) return std::optional<Eigen::Isometry3d>{};
   return std::optional<Eigen::Isometry3d>{r->best.cam_T_obj};
 }
@@ -37,7 +38,10 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
                                                                                           double t_s) {
   ++start_attempts_;
   auto r = detect(frame, t_s, std::nullopt);
-  if (r && *r) start_frame_ = frame_number;
+  if (r && *r) {
+    start_frame_ = frame_number;
+    provisional_from(t_s);
+  }
   return r;
 }
 
@@ -60,11 +64,31 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   auto r = detect(frame, t_s, predicted);
   if (r && *r) {
     ++reacquired_;
+    provisional_from(t_s);
     frames_to_reacquire_.push_back(lost_run_);
     lost_run_ = 0;
     in_loss_ = false;
   }
   return r;
+}
+
+bool TrackAcquisition::recheck_due(double t_s) const {
+  return options_.provisional_s > 0 && t_s <= provisional_until_s_ && t_s >= next_recheck_s_;
+}
+
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::recheck(const cv::Mat& frame, double t_s,
+                                                                                       const Eigen::Isometry3d& tracked) {
+  next_recheck_s_ = t_s + options_.recheck_interval_s;
+  ++rechecks_;
+  auto found = detect(frame, t_s, std::nullopt);
+  if (!found) return found;
+  const auto now = detector_->verify(frame, tracked);
+  if (!now) return std::unexpected(now.error());
+  recheck_log_.push_back({{"t_s", t_s}, {"found", found->has_value()}, {"found_score", last_score_}, {"tracked_score", now->score}});
+  if (!*found || last_score_ < options_.switch_ratio * now->score) return std::optional<Eigen::Isometry3d>{};
+  ++switches_;
+  provisional_from(t_s);
+  return found;
 }
 
 nlohmann::json TrackAcquisition::to_json() const {
@@ -76,6 +100,9 @@ nlohmann::json TrackAcquisition::to_json() const {
                       {"reacquisitions", reacquired_},
                       {"frames_to_reacquire", frames_to_reacquire_},
                       {"detections", detections_},
+                      {"rechecks", rechecks_},
+                      {"switches", switches_},
+                      {"recheck_log", recheck_log_},
                       {"detect_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},
                       {"detect_ms_max", ms.empty() ? 0.0 : ms.back()}};
   if (detector_) {

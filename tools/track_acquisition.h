@@ -25,6 +25,13 @@ struct AcquisitionOptions {
   bool use_imu_gravity = false;      // gravity from imu.csv narrows the search (with --object-up)
   bool reacquire = true;             // detect after a loss (false: retry from the last pose only)
   int lost_frames_before_detection = 3;
+  // A pose found by detection is provisional for this long: every recheck_interval_s the whole
+  // search runs again, and a pose that explains a much longer outline than the tracked one
+  // (score at least switch_ratio times) takes over. Clutter can hold a box-like outline (a
+  // printed rectangle) before the object itself comes into view (late_entry).
+  double provisional_s = 3.0;
+  double recheck_interval_s = 0.5;
+  double switch_ratio = 1.5;
 };
 
 class TrackAcquisition {
@@ -39,9 +46,18 @@ class TrackAcquisition {
   // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
   std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, int frame_number, double t_s,
                                                                           const Eigen::Isometry3d& predicted);
+  // While a detected start is provisional and a recheck is due at t_s: the whole search on
+  // this frame, and the pose to switch to when it explains a much longer outline than `tracked`.
+  bool recheck_due(double t_s) const;
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> recheck(const cv::Mat& frame, double t_s,
+                                                                       const Eigen::Isometry3d& tracked);
   nlohmann::json to_json() const;
 
  private:
+  void provisional_from(double t_s) {
+    provisional_until_s_ = t_s + options_.provisional_s;
+    next_recheck_s_ = t_s + options_.recheck_interval_s;
+  }
   std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
                                                                       const std::optional<Eigen::Isometry3d>& near);
   const vision::Sequence* seq_;
@@ -52,6 +68,10 @@ class TrackAcquisition {
   int start_frame_ = -1, start_attempts_ = 0;
   int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
   bool in_loss_ = false;
+  double provisional_until_s_ = -1, next_recheck_s_ = 0;
+  int rechecks_ = 0, switches_ = 0;
+  double last_score_ = 0;
+  nlohmann::json recheck_log_ = nlohmann::json::array();  // of the last detection's best hypothesis
   std::vector<int> frames_to_reacquire_;
   std::vector<double> detect_ms_;
 };

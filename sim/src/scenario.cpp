@@ -34,7 +34,8 @@ std::expected<Scenario, std::string> load_scenario(const std::string& path) {
 }
 
 const std::vector<std::string>& builtin_scenario_names() {
-  static const std::vector<std::string> names{"mockup_walk", "lampshade", "box_clutter", "office_pan", "can", "bowl"};
+  static const std::vector<std::string> names{"mockup_walk", "lampshade", "box_clutter", "office_pan", "can",
+                                              "bowl", "late_entry", "box_cover", "stumble"};
   return names;
 }
 

@@ -68,17 +68,41 @@ std::string list(const V& v) {
 
 }  // namespace
 
-double object_view_margin_px(const Scenario& s, const Scene& scene, const vision::Camera& camera) {
-  const Rig rig = Rig::from_scenario(s, scene.view.target_world, scene.world_T_obj);
-  const Vector3d centre_obj = scene.world_T_obj.inverse() * scene.view.target_world;
-  double worst = 1e9;
-  for (int i = 0; i < s.frames; ++i) {
+namespace {
+// The object centre's distance from the image border at frame i (-1e9 behind the camera).
+struct CentreMargin {
+  Rig rig;
+  Vector3d centre_obj;
+  double at(const Scenario& s, const vision::Camera& camera, int i) const {
     const Vector3d p = rig.cam_T_obj(s.frame_time_s(i)) * centre_obj;
     if (p.z() < 0.05) return -1e9;
     const Eigen::Vector2d uv = camera.project(p);
-    worst = std::min({worst, uv.x(), uv.y(), camera.width_px() - 1 - uv.x(), camera.height_px() - 1 - uv.y()});
+    return std::min({uv.x(), uv.y(), camera.width_px() - 1 - uv.x(), camera.height_px() - 1 - uv.y()});
+  }
+};
+CentreMargin centre_margin(const Scenario& s, const Scene& scene) {
+  return {Rig::from_scenario(s, scene.view.target_world, scene.world_T_obj),
+          scene.world_T_obj.inverse() * scene.view.target_world};
+}
+}  // namespace
+
+double object_view_margin_px(const Scenario& s, const Scene& scene, const vision::Camera& camera,
+                             const std::vector<unsigned char>* frames) {
+  const CentreMargin m = centre_margin(s, scene);
+  double worst = 1e9;
+  for (int i = 0; i < s.frames; ++i) {
+    if (frames && (static_cast<std::size_t>(i) >= frames->size() || !(*frames)[static_cast<std::size_t>(i)])) continue;
+    worst = std::min(worst, m.at(s, camera, i));
+    if (worst <= -1e9) return worst;
   }
   return worst;
+}
+
+std::vector<unsigned char> frames_in_view(const Scenario& s, const Scene& scene, const vision::Camera& camera) {
+  const CentreMargin m = centre_margin(s, scene);
+  std::vector<unsigned char> in(static_cast<std::size_t>(std::max(0, s.frames)));
+  for (int i = 0; i < s.frames; ++i) in[static_cast<std::size_t>(i)] = m.at(s, camera, i) >= kMinBorderPx;
+  return in;
 }
 
 std::expected<ScenarioScene, std::string> make_scenario_scene(const Scenario& s) {
@@ -88,7 +112,9 @@ std::expected<ScenarioScene, std::string> make_scenario_scene(const Scenario& s)
   auto camera = scenario_camera(s);
   if (!camera) return std::unexpected(camera.error());
 
-  // Camera path and placement first: they decide whether the object stays in view.
+  // Camera path and placement first: they decide whether the object stays in view (in the
+  // frames where the built-in scene keeps it in view).
+  const std::vector<unsigned char> in_view = frames_in_view(s, *nominal, *camera);
   ScenarioScene out{{}, s, {}};
   SceneVariety& v = out.drawn;
   v.variety = s.variety;
@@ -104,7 +130,7 @@ std::expected<ScenarioScene, std::string> make_scenario_scene(const Scenario& s)
     Scene probe = *nominal;  // textures are shared, not copied
     probe.world_T_obj = world_T_obj;
     probe.view.target_world = world_T_obj * nominal->view.target_world;
-    trial.min_border_px = object_view_margin_px(run, probe, *camera);
+    trial.min_border_px = object_view_margin_px(run, probe, *camera, &in_view);
     if (trial.min_border_px >= kMinBorderPx) {
       found = true;
       trial.variety = s.variety;
@@ -121,7 +147,7 @@ std::expected<ScenarioScene, std::string> make_scenario_scene(const Scenario& s)
     v.attempt = s.variety <= 0 ? 0 : kAttempts;
     world_T_obj = Eigen::Isometry3d::Identity();
     d = draw(s.seed, 0);
-    v.min_border_px = object_view_margin_px(s, *nominal, *camera);
+    v.min_border_px = object_view_margin_px(s, *nominal, *camera, &in_view);
   }
   const double applied = v.applied;
   Scenario& run = out.scenario;

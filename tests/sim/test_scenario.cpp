@@ -117,7 +117,7 @@ TEST_CASE("scenario files: unreadable paths and unknown names are errors, relati
 }
 
 TEST_CASE("every built-in scenario parses and names a built-in scene", "[sim][scenario]") {
-  REQUIRE(builtin_scenario_names().size() == 6);
+  REQUIRE(builtin_scenario_names().size() == 9);
   for (const auto& name : builtin_scenario_names()) {
     const Scenario s = builtin(name);
     CHECK(s.name == name);

@@ -117,6 +117,7 @@ struct Detector::Impl {
   Eigen::Vector3d centre_obj = Eigen::Vector3d::Zero();
   double radius_m = 0;
   std::vector<Eigen::Vector3d> outline_obj;  // model points whose projections stand for a pose's outline
+  std::vector<Eigen::Vector2d> scratch_outline;
 
   void project_outline(const Eigen::Isometry3d& T, std::vector<Eigen::Vector2d>& px) const {
     px.clear();
@@ -144,8 +145,16 @@ struct Detector::Impl {
   Eigen::Isometry3d template_pose(int view, int roll, double distance_m) const;
   std::vector<std::string> classes_for(const DetectionPrior& prior) const;
   std::vector<Eigen::Isometry3d> hypotheses(const std::vector<cv::linemod::Match>& matches, const DetectionPrior& prior,
-                                            std::vector<float>& similarity) const;
+                                            std::vector<float>& similarity);
   DetectionHypothesis refine(const Eigen::Isometry3d& start, float similarity);
+  // Support, score and outline length of h's pose on the current frame (gradients).
+  // whole_object: a pose with part of the model outside the image scores 0 (detections).
+  DetectionHypothesis measure(DetectionHypothesis h, bool whole_object = true);
+  // Takes a frame: the matcher's BGR (padded), the grey gradients and the tracker's image.
+  std::expected<cv::Mat, std::string> take_frame(const cv::Mat& frame);
+  bool verified(const DetectionHypothesis& h) const {
+    return h.support >= options.min_support && h.supported_px >= options.min_supported_px;
+  }
 };
 
 std::uint64_t Detector::Impl::key() const {
@@ -277,18 +286,25 @@ std::vector<std::string> Detector::Impl::classes_for(const DetectionPrior& prior
 }
 
 std::vector<Eigen::Isometry3d> Detector::Impl::hypotheses(const std::vector<cv::linemod::Match>& matches,
-                                                          const DetectionPrior& prior, std::vector<float>& similarity) const {
-  std::vector<Eigen::Isometry3d> out;
-  std::vector<std::vector<Eigen::Vector2d>> outlines;
-  std::vector<Eigen::Vector2d> outline;
-  // Small templates (far distances) are simple outlines that printed texture and clutter match
-  // as well as the object: the hypotheses are shared out over the distances so that the
-  // object's own scale always gets its turn.
-  const int per_distance = std::max(2, (options.max_hypotheses + static_cast<int>(distances_m.size()) - 1) /
-                                           std::max(1, static_cast<int>(distances_m.size())));
+                                                          const DetectionPrior& prior, std::vector<float>& similarity) {
+  // Stage 1: the template poses of the best matches, shared out over the distances (small
+  // templates are simple outlines that printed texture and clutter match as well as the
+  // object does, and would take every place), each given a quick score: how much of its
+  // outline an image edge supports within a few pixels, at the template's pose as it is.
+  struct Candidate {
+    Eigen::Isometry3d T;
+    float similarity;
+    double score;
+  };
+  std::vector<Candidate> candidates;
+  const int n_dist = std::max(1, static_cast<int>(distances_m.size()));
+  const int per_distance = std::max(2, (options.max_candidates + n_dist - 1) / n_dist);
   std::vector<int> taken(distances_m.size(), 0);
+  detail::EdgeSupportOptions quick;
+  quick.radius_px = options.candidate_radius_px;
+  quick.step_px = 4.0;
   for (const auto& m : matches) {
-    if (static_cast<int>(out.size()) >= options.max_hypotheses) break;
+    if (static_cast<int>(candidates.size()) >= options.max_candidates) break;
     const auto it = class_specs.find(m.class_id);
     if (it == class_specs.end() || m.template_id < 0 || m.template_id >= static_cast<int>(it->second.size())) continue;
     const auto& s = specs[static_cast<std::size_t>(it->second[static_cast<std::size_t>(m.template_id)])];
@@ -302,18 +318,28 @@ std::vector<Eigen::Isometry3d> Detector::Impl::hypotheses(const std::vector<cv::
     T.linear() = align * T.linear();
     T.translation() = ray * s.distance_m - T.linear() * centre_obj;
     if (prior.up_cam && prior.up_obj && angle_deg(T.linear() * *prior.up_obj, *prior.up_cam) > options.up_tolerance_deg) continue;
-    // A hypothesis whose outline lies on a kept one's adds nothing. Compared by the projected
-    // model points as sets, so the views a symmetric object cannot tell apart (a box turned
-    // half round) count as one.
-    project_outline(T, outline);
+    ++taken[static_cast<std::size_t>(s.distance)];
+    visibility.compute(T, visible);
+    const detail::EdgeSupport support = detail::edge_support(gradients, visible, quick);
+    candidates.push_back({T, m.similarity, support.share * static_cast<double>(support.supported)});
+  }
+  // Stage 2: the best scored, without the ones whose outline lies on a kept one's. Compared
+  // by the projected model points as sets, so the views a symmetric object cannot tell apart
+  // (a box turned half round) count as one.
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::vector<Eigen::Isometry3d> out;
+  std::vector<std::vector<Eigen::Vector2d>> outlines;
+  std::vector<Eigen::Vector2d> outline;
+  for (const auto& c : candidates) {
+    if (static_cast<int>(out.size()) >= options.max_hypotheses) break;
+    project_outline(c.T, outline);
     bool near_kept = false;
     for (std::size_t k = 0; k < out.size() && !near_kept; ++k)
       near_kept = outline_distance_px(outline, outlines[k]) < options.duplicate_px;
     if (near_kept) continue;
     outlines.push_back(outline);
-    out.push_back(T);
-    ++taken[static_cast<std::size_t>(s.distance)];
-    similarity.push_back(m.similarity);
+    out.push_back(c.T);
+    similarity.push_back(c.similarity);
   }
   return out;
 }
@@ -337,6 +363,20 @@ DetectionHypothesis Detector::Impl::refine(const Eigen::Isometry3d& start, float
     h.status = report.status;
     if (report.status != TrackStatus::Lost) h.cam_T_obj = report.cam_T_obj;
   }
+  return measure(h);
+}
+
+DetectionHypothesis Detector::Impl::measure(DetectionHypothesis h, bool whole_object) {
+  // Like its templates, a detection must see the whole object: a pose that puts part of the
+  // model outside the image is verified on a clipped outline, which clutter at the border
+  // supports as readily as the object (late_entry: a box on the wall's printed rectangles).
+  project_outline(h.cam_T_obj, scratch_outline);
+  const bool whole = scratch_outline.size() == outline_obj.size() &&
+                     std::all_of(scratch_outline.begin(), scratch_outline.end(), [&](const Eigen::Vector2d& p) { return camera.in_image(p); });
+  if (whole_object && !whole) {
+    h.support = h.score = 0;
+    return h;
+  }
   visibility.compute(h.cam_T_obj, visible);
   detail::EdgeSupportOptions so;
   so.radius_px = options.support_radius_px;
@@ -344,6 +384,7 @@ DetectionHypothesis Detector::Impl::refine(const Eigen::Isometry3d& start, float
     const detail::EdgeSupport support = detail::edge_support(gradients, visible, so);
     h.support = support.share;
     h.score = support.share * static_cast<double>(support.supported);
+    h.supported_px = static_cast<double>(support.supported) * so.step_px;
   }
   return h;
 }
@@ -401,17 +442,14 @@ std::expected<std::unique_ptr<Detector>, std::string> Detector::create(const Cad
   return std::unique_ptr<Detector>(new Detector(std::move(impl)));
 }
 
-std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& frame, const DetectionPrior& prior) {
-  Impl& d = *impl_;
+std::expected<cv::Mat, std::string> Detector::Impl::take_frame(const cv::Mat& frame) {
   if (frame.empty() || frame.depth() != CV_8U || (frame.channels() != 1 && frame.channels() != 3))
     return std::unexpected("detect: the frame must be 8-bit grey or BGR");
-  if (frame.cols != d.camera.width_px() || frame.rows != d.camera.height_px())
+  if (frame.cols != camera.width_px() || frame.rows != camera.height_px())
     return std::unexpected("detect: the frame is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
-                           " but the calibration is " + std::to_string(d.camera.width_px()) + "x" +
-                           std::to_string(d.camera.height_px()));
-  DetectionResult result;
-  if (auto ok = d.window_image.assign(frame); !ok) return std::unexpected("detect: " + ok.error());
-  const auto t0 = Clock::now();
+                           " but the calibration is " + std::to_string(camera.width_px()) + "x" +
+                           std::to_string(camera.height_px()));
+  if (auto ok = window_image.assign(frame); !ok) return std::unexpected("detect: " + ok.error());
   cv::Mat grey, bgr;
   if (frame.channels() == 1) {
     grey = frame;
@@ -420,13 +458,33 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
     bgr = frame;
     cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
   }
-  d.gradients.compute(grey);
+  gradients.compute(grey);
+  const int pad_x = (kPadMultiple - bgr.cols % kPadMultiple) % kPadMultiple;
+  const int pad_y = (kPadMultiple - bgr.rows % kPadMultiple) % kPadMultiple;
+  if (pad_x || pad_y) cv::copyMakeBorder(bgr, bgr, 0, pad_y, 0, pad_x, cv::BORDER_REPLICATE);
+  return bgr;
+}
+
+std::expected<DetectionHypothesis, std::string> Detector::verify(const cv::Mat& frame, const Eigen::Isometry3d& cam_T_obj) {
+  if (auto ok = impl_->take_frame(frame); !ok) return std::unexpected(ok.error());
+  DetectionHypothesis h;
+  h.cam_T_obj = h.start_cam_T_obj = cam_T_obj;
+  h.status = TrackStatus::Tracked;
+  return impl_->measure(h, false);
+}
+
+std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& frame, const DetectionPrior& prior) {
+  Impl& d = *impl_;
+  DetectionResult result;
+  const auto t0 = Clock::now();
+  auto bgr = d.take_frame(frame);
+  if (!bgr) return std::unexpected(bgr.error());
   // Near the prediction first: when the object is where it was expected, no search is needed.
   if (prior.near_cam_T_obj) {
     const auto t_near = Clock::now();
     DetectionHypothesis near = d.refine(*prior.near_cam_T_obj, 0.0f);
     result.refine_ms += ms_since(t_near);
-    if (near.support >= d.options.min_support) {
+    if (d.verified(near)) {
       result.best = near;
       result.found = true;
       result.hypotheses.push_back(near);
@@ -434,14 +492,11 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
     }
     result.hypotheses.push_back(near);
   }
-  const int pad_x = (kPadMultiple - bgr.cols % kPadMultiple) % kPadMultiple;
-  const int pad_y = (kPadMultiple - bgr.rows % kPadMultiple) % kPadMultiple;
-  if (pad_x || pad_y) cv::copyMakeBorder(bgr, bgr, 0, pad_y, 0, pad_x, cv::BORDER_REPLICATE);
 
   const std::vector<std::string> classes = d.classes_for(prior);
   for (const auto& id : classes) result.templates_matched += static_cast<int>(d.class_specs.at(id).size());
   std::vector<cv::linemod::Match> matches;
-  if (!classes.empty()) d.line2d->match({bgr}, d.options.min_similarity, matches, classes);
+  if (!classes.empty()) d.line2d->match({*bgr}, d.options.min_similarity, matches, classes);
   result.matches = static_cast<int>(matches.size());
   std::vector<float> similarity;
   const std::vector<Eigen::Isometry3d> starts = d.hypotheses(matches, prior, similarity);
@@ -454,7 +509,7 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   result.refine_ms += ms_since(t1);
   if (!result.hypotheses.empty()) {
     result.best = result.hypotheses.front();
-    result.found = result.best.support >= d.options.min_support;
+    result.found = d.verified(result.best);
   }
   return result;
 }

@@ -74,10 +74,15 @@ struct ScenarioScene {
 std::expected<ScenarioScene, std::string> make_scenario_scene(const Scenario& scenario);
 
 // Smallest distance (pixels) of the projected object centre (the scene's view target) from the
-// image border over every frame of the scenario; negative when it leaves the image or goes behind
-// the camera. The rule a drawn scene must pass (>= kMinBorderPx).
-double object_view_margin_px(const Scenario& scenario, const Scene& scene, const vision::Camera& camera);
+// image border over every frame of the scenario (or only the frames marked in `frames`);
+// negative when it leaves the image or goes behind the camera. The rule a drawn scene must
+// pass (>= kMinBorderPx) in every frame where the built-in scene keeps the object in view: a
+// scenario may take the object out of view on purpose (late_entry, stumble).
+double object_view_margin_px(const Scenario& scenario, const Scene& scene, const vision::Camera& camera,
+                             const std::vector<unsigned char>* frames = nullptr);
 inline constexpr double kMinBorderPx = 24;
+// Per frame: the object centre lies at least kMinBorderPx inside the image.
+std::vector<unsigned char> frames_in_view(const Scenario& scenario, const Scene& scene, const vision::Camera& camera);
 
 // The draws as a JSON object (no trailing newline), each line prefixed by `indent`.
 std::string to_json(const SceneVariety& drawn, const std::string& indent);

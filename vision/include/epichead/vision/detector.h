@@ -32,17 +32,23 @@ struct DetectorOptions {
   int view_subdivisions = 2;
   double in_plane_step_deg = 15.0;  // turns about the line of sight
   // Distance range of the object's centre, m; 0 = from the model's size and the image: the
-  // object spans from min_span to max_span of the image's shorter side.
+  // diameter of the model's bounding sphere spans from min_span to max_span of the image's
+  // shorter side (the sphere is larger than what a view shows, hence above 1; templates of
+  // views that do not fit in the image are not made).
   double min_distance_m = 0, max_distance_m = 0;
-  double min_span = 0.2, max_span = 0.9;
+  double min_span = 0.3, max_span = 1.2;
   double distance_ratio = 1.2;  // between neighbouring template distances
   int features_per_template = 63;
   // With a known gravity direction: only views whose object up lies within this of the
   // camera's up are matched (gravity from the accelerometer, the object's up from the model).
   double up_tolerance_deg = 25.0;
-  // Hypotheses: LINE-2D matches at or above min_similarity (percent), the best max_hypotheses
-  // of them after suppressing neighbours (same place, near the same view) refined and verified.
+  // Hypotheses: of the LINE-2D matches at or above min_similarity (percent), the best
+  // max_candidates (shared out over the distances) are scored by the edge support of their
+  // outline within candidate_radius_px at the template's pose; the best max_hypotheses of
+  // those, without duplicates, are refined and verified.
   float min_similarity = 75.0f;
+  int max_candidates = 2000;
+  double candidate_radius_px = 4.0;
   int max_hypotheses = 48;
   double duplicate_px = 8.0;  // hypotheses whose projected model points lie this close are one
   int refine_passes = 8;  // tracking steps on the frame from each hypothesis
@@ -50,6 +56,10 @@ struct DetectorOptions {
   // samples has an image edge of its orientation within support_radius_px.
   double min_support = 0.55;
   double support_radius_px = 2.0;
+  // ... and the supported part of the outline is at least this long: a short outline (a far
+  // box seen face-on is a rectangle) is matched by printed rectangles in clutter as readily as
+  // by the object (late_entry: 0.81 of a 300 px outline on a poster).
+  double min_supported_px = 400.0;
 };
 
 // A pose found in one frame.
@@ -62,6 +72,7 @@ struct DetectionHypothesis {
   // explains more outline wins, so a small outline matched on printed texture or clutter
   // loses against the whole object.
   double score = 0;
+  double supported_px = 0;  // length of the outline an image edge supports
   TrackStatus status = TrackStatus::Lost;  // of the last refinement step
 };
 
@@ -100,6 +111,11 @@ class Detector {
 
   // Finds the model in `frame` (8-bit grey or BGR, the camera's size).
   std::expected<DetectionResult, std::string> detect(const cv::Mat& frame, const DetectionPrior& prior = {});
+
+  // The verification of one pose as it is (no search, no refinement): support, score and
+  // outline length, as detect() gives its hypotheses, over the part of the model in the image.
+  // For comparing the tracked pose with a detection on the same frame.
+  std::expected<DetectionHypothesis, std::string> verify(const cv::Mat& frame, const Eigen::Isometry3d& cam_T_obj);
 
   int template_count() const;
   bool loaded_from_cache() const;
