@@ -14,6 +14,7 @@
 #include <map>
 
 #include "command.h"
+#include "detection_setup.h"
 #include "stop_signals.h"
 #include "onboard_summary_json.h"
 #include "run_config.h"
@@ -49,9 +50,13 @@ int run_onboard(const std::string& config_path, double seconds) {
   if (!model) return fail(cmd, model.error());
   auto camera_model = vision::Camera::load(config->calibration);
   if (!camera_model) return fail(cmd, camera_model.error());
-  auto init = vision::read_pose_csv(config->init_pose);
-  if (!init) return fail(cmd, init.error());
-  if (init->empty()) return fail(cmd, config->init_pose + ": no pose");
+  std::optional<Eigen::Isometry3d> init_pose;
+  if (!config->init_pose.empty()) {
+    auto init = vision::read_pose_csv(config->init_pose);
+    if (!init) return fail(cmd, init.error());
+    if (init->empty()) return fail(cmd, config->init_pose + ": no pose");
+    init_pose = init->front().cam_T_obj;
+  }
   std::error_code ec;
   fs::create_directories(config->out, ec);
   if (ec) return fail(cmd, "cannot create " + config->out + ": " + ec.message());
@@ -98,7 +103,17 @@ int run_onboard(const std::string& config_path, double seconds) {
   options.realtime = config->threads;
   auto loop = head::OnboardLoop::create(*model, *camera_model, options, ports);
   if (!loop) return fail(cmd, loop.error());
-  (*loop)->set_initial_pose(clock.now_s(), init->front().cam_T_obj);
+  // Detection: the start when no init_pose is given, and after every loss. Templates are read
+  // from the cache (or built, with progress) before the loop starts: never on its clock.
+  if (!init_pose || config->reacquire) {
+    DetectionArgs detection;
+    if (!config->template_cache.empty()) detection.cache_dir = config->template_cache;
+    auto detector = make_detector(cmd, *model, *camera_model, detection, options.tracker);
+    if (!detector) return fail(cmd, detector.error());
+    (*loop)->set_detector(std::move(*detector));
+  }
+  if (init_pose) (*loop)->set_initial_pose(clock.now_s(), *init_pose);
+  else std::printf("run: no init_pose: the object is detected from the model\n");
   const double until = seconds > 0 ? clock.now_s() + seconds : std::numeric_limits<double>::infinity();
   running_loop.store(loop->get());
   on_stop_signals(on_run_stop_signal);

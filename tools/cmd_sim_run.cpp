@@ -24,14 +24,17 @@
 #include <opencv2/imgproc.hpp>
 
 #include "command.h"
+#include "detection_setup.h"
 #include "onboard_summary_json.h"
 #include "process_memory.h"
 #include "plot/line_plot.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/head/target_observation.h"
+#include "epichead/sim/rig.h"
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
+#include "epichead/vision/offline/model_symmetry.h"
 #include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/visibility.h"
 
@@ -53,6 +56,9 @@ struct SimRunArgs {
   bool soak = false;              // the closed run alone, watched for memory growth and attitude drift
   double soak_warmup_s = 60;
   std::string threads = "simulated";  // simulated (deterministic) | wall (vision on its own thread, as on the robot)
+  bool no_init = false;    // no start pose: detection finds the object
+  bool reacquire = false;  // detection after a loss (always with no_init)
+  DetectionArgs detection;
 };
 
 // What one closed run measured against the simulator's truth.
@@ -90,9 +96,120 @@ bool write_overlay(const head::TrackedFrame& f, const vision::CadModel& model, c
   return cv::imwrite((fs::path(out) / name).string(), canvas);
 }
 
+// The simulator's truth, sampled every millisecond as simulated time advances: the camera's
+// angular rate (for the RMS against the fixed head), the target's offset from the image centre,
+// the timeline CSV and the plots' series, and with --soak the process's resident memory.
+class TruthMeter {
+ public:
+  TruthMeter(sim::SimWorld& world, const vision::CadModel& model, const SimRunArgs& a, RunMeasures& m)
+      : w_(world), a_(a), m_(m), cam_(world.camera_model()) {
+    for (const auto& v : model.vertices) centre_obj_ += v;
+    if (!model.vertices.empty()) centre_obj_ /= static_cast<double>(model.vertices.size());
+  }
+  std::expected<void, std::string> open_timeline(const std::string& path) {
+    timeline_.open(path);
+    if (!timeline_) return std::unexpected("cannot write " + path);
+    timeline_ << "t_s,cam_rate_x_degps,cam_rate_y_degps,cam_rate_z_degps,pan_deg,tilt_deg,pan_rate_degps,tilt_rate_degps,"
+                 "target_dx_px,target_dy_px\n";
+    return {};
+  }
+  std::expected<void, std::string> sample(double t_s) {
+    auto truth = w_.truth_at(w_.now_s());
+    if (!truth) return std::unexpected(truth.error());
+    const Eigen::Vector3d r = truth->cam_rate_radps * 180.0 / M_PI;
+    // The RMS leaves out the first settle_s: the head's first slew toward the target is wanted
+    // motion, not disturbance (the same window is left out of the fixed-head run).
+    if (truth->t_s >= a_.settle_s) {
+      sq_xy_ += r.x() * r.x() + r.y() * r.y();
+      sq_all_ += r.squaredNorm();
+      ++samples_;
+    }
+    const Eigen::Vector2d off = head::offset_from_centre_px(cam_, truth->cam_T_obj * centre_obj_);
+    if (off.allFinite()) {
+      sq_centre_ += off.squaredNorm();
+      ++centre_n_;
+      m_.centring_max_px = std::max(m_.centring_max_px, off.norm());
+    }
+    if (timeline_.is_open()) write_row(*truth, r, off);
+    if (a_.soak) sample_memory(t_s);
+    else if (samples_ % 10 == 0) sample_plots(t_s, *truth, r, off);  // plots at 100 Hz
+    return {};
+  }
+  void finish() {
+    m_.cam_rate_rms_degps = samples_ ? std::sqrt(sq_xy_ / static_cast<double>(samples_)) : 0;
+    m_.cam_rate_rms_all_degps = samples_ ? std::sqrt(sq_all_ / static_cast<double>(samples_)) : 0;
+    m_.centring_rms_px = centre_n_ ? std::sqrt(sq_centre_ / static_cast<double>(centre_n_)) : 0;
+  }
+
+ private:
+  void write_row(const sim::SimTruth& truth, const Eigen::Vector3d& r, const Eigen::Vector2d& off) {
+    constexpr double deg = 180.0 / M_PI;
+    char row[256];
+    std::snprintf(row, sizeof row, "%.4f,%.4f,%.4f,%.4f,%.5f,%.5f,%.4f,%.4f,%.2f,%.2f\n", truth.t_s, r.x(), r.y(), r.z(),
+                  truth.joints.pan_rad * deg, truth.joints.tilt_rad * deg, truth.joints.pan_rate_radps * deg,
+                  truth.joints.tilt_rate_radps * deg, off.x(), off.y());
+    timeline_ << row;
+  }
+  void sample_memory(double t_s) {
+    const long ms = std::lround(t_s * 1e3);
+    if (ms % 10000 != 0 && !(m_.rss_warm_kib == 0 && t_s >= a_.soak_warmup_s)) return;
+    const double rss = resident_kib().value_or(0);
+    m_.rss_max_kib = std::max(m_.rss_max_kib, rss);
+    m_.rss_end_kib = rss;  // the last sample inside the run: the summary's own copies come after
+    if (m_.rss_warm_kib == 0 && t_s >= a_.soak_warmup_s) m_.rss_warm_kib = rss;
+  }
+  void sample_plots(double t_s, const sim::SimTruth& truth, const Eigen::Vector3d& r, const Eigen::Vector2d& off) {
+    m_.rate_xy.x.push_back(t_s);
+    m_.rate_xy.y.push_back(std::hypot(r.x(), r.y()));
+    m_.pan.x.push_back(t_s);
+    m_.pan.y.push_back(truth.joints.pan_rad * 180 / M_PI);
+    m_.tilt.x.push_back(t_s);
+    m_.tilt.y.push_back(truth.joints.tilt_rad * 180 / M_PI);
+    m_.centring.x.push_back(t_s);
+    m_.centring.y.push_back(off.allFinite() ? off.norm() : std::nan(""));
+  }
+  sim::SimWorld& w_;
+  const SimRunArgs& a_;
+  RunMeasures& m_;
+  vision::Camera cam_;
+  Eigen::Vector3d centre_obj_ = Eigen::Vector3d::Zero();
+  std::ofstream timeline_;
+  double sq_xy_ = 0, sq_all_ = 0, sq_centre_ = 0;
+  long samples_ = 0, centre_n_ = 0;
+};
+
+// Each published frame against the truth: success (5 cm / 5 deg), the soak's attitude error,
+// and the overlays.
+// `symmetries`: the model's own (model_symmetry.h), since a detected start may be any of them.
+void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunArgs& a,
+                   const std::vector<Eigen::Isometry3d>& symmetries, RunMeasures& m) {
+  if (a.soak) {
+    if (auto truth = w.truth_at(f.exposure_t_s)) {
+      const Eigen::Matrix3d d = f.predicted_cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
+      if (m.attitude_errors < m.attitude_error_deg.size())
+        m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
+    }
+  }
+  if (f.report->status != vision::TrackStatus::Lost) {
+    if (auto truth = w.truth_at(f.exposure_t_s)) {
+      bool success = false;
+      for (std::size_t k = 0; k <= symmetries.size() && !success; ++k) {
+        const Eigen::Isometry3d est = k == 0 ? f.report->cam_T_obj : f.report->cam_T_obj * symmetries[k - 1];
+        const double rot_deg = Eigen::AngleAxisd(est.linear() * truth->cam_T_obj.linear().transpose()).angle() * 180 / M_PI;
+        const double t_m = (est.translation() - truth->cam_T_obj.translation()).norm();
+        success = rot_deg <= 5.0 && t_m <= 0.05;
+      }
+      m.succeeded += success;
+    }
+  }
+  ++m.frames;
+}
+
+// One closed run. `detector` (may be null) finds the object without a start pose (--no-init)
+// and after losses; the run takes it.
 std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& scenario, const SimRunArgs& a,
                                                           head::ControlMode mode, bool render, const std::string& out,
-                                                          RunMeasures& m) {
+                                                          RunMeasures& m, std::unique_ptr<vision::Detector> detector = {}) {
   sim::SimWorldOptions wo;
   wo.camera = render ? sim::CameraOutput::Render : sim::CameraOutput::Blank;
   wo.camera_downscale = a.downscale;
@@ -116,22 +233,11 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
     if (!a.soak) o.candump_path = (fs::path(out) / "bus.log").string();
     o.diagnostics_path = (fs::path(out) / "diagnostics.jsonl").string();
   }
-  // The truth is sampled every millisecond as simulated time advances.
-  double sq_xy = 0, sq_all = 0;
-  long samples = 0;
   const vision::Camera cam = w.camera_model();
-  Eigen::Vector3d centre_obj = Eigen::Vector3d::Zero();
-  for (const auto& v : model->vertices) centre_obj += v;
-  if (!model->vertices.empty()) centre_obj /= static_cast<double>(model->vertices.size());
-  double sq_centre = 0;
-  long centre_n = 0;
-  std::ofstream timeline;
-  if (render && !a.soak) {
-    timeline.open(fs::path(out) / "timeline.csv");
-    if (!timeline) return std::unexpected("cannot write " + (fs::path(out) / "timeline.csv").string());
-    timeline << "t_s,cam_rate_x_degps,cam_rate_y_degps,cam_rate_z_degps,pan_deg,tilt_deg,pan_rate_degps,tilt_rate_degps,"
-                "target_dx_px,target_dy_px\n";
-  }
+  const std::vector<Eigen::Isometry3d> symmetries = vision::model_symmetries(*model);
+  TruthMeter meter(w, *model, a, m);
+  if (render && !a.soak)
+    if (auto ok = meter.open_timeline((fs::path(out) / "timeline.csv").string()); !ok) return std::unexpected(ok.error());
   head::OnboardPorts ports;
   ports.clock = &w.clock();
   ports.bus = &w.bus();
@@ -144,93 +250,34 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   ports.wait_until = [&](double t_s) -> std::expected<void, std::string> {
     if (auto ok = w.advance_to(t_s); !ok) return ok;
     if (wall) std::this_thread::sleep_until(wall_start + std::chrono::duration<double>(t_s - sim_start_s));
-    auto truth = w.truth_at(w.now_s());
-    if (!truth) return std::unexpected(truth.error());
-    const Eigen::Vector3d r = truth->cam_rate_radps * 180.0 / M_PI;
-    // The RMS leaves out the first settle_s: the head's first slew toward the target is wanted
-    // motion, not disturbance (the same window is left out of the fixed-head run).
-    if (truth->t_s >= a.settle_s) {
-      sq_xy += r.x() * r.x() + r.y() * r.y();
-      sq_all += r.squaredNorm();
-      ++samples;
-    }
-    const Eigen::Vector3d p = truth->cam_T_obj * centre_obj;
-    const Eigen::Vector2d off = head::offset_from_centre_px(cam, p);
-    if (off.allFinite()) {
-      sq_centre += off.squaredNorm();
-      ++centre_n;
-      m.centring_max_px = std::max(m.centring_max_px, off.norm());
-    }
-    if (timeline.is_open()) {
-      constexpr double deg = 180.0 / M_PI;
-      char row[256];
-      std::snprintf(row, sizeof row, "%.4f,%.4f,%.4f,%.4f,%.5f,%.5f,%.4f,%.4f,%.2f,%.2f\n", truth->t_s, r.x(), r.y(), r.z(),
-                    truth->joints.pan_rad * deg, truth->joints.tilt_rad * deg, truth->joints.pan_rate_radps * deg,
-                    truth->joints.tilt_rate_radps * deg, off.x(), off.y());
-      timeline << row;
-    }
-    if (a.soak) {
-      const long ms = std::lround(t_s * 1e3);
-      if (ms % 10000 == 0 || (m.rss_warm_kib == 0 && t_s >= a.soak_warmup_s)) {
-        const double rss = resident_kib().value_or(0);
-        m.rss_max_kib = std::max(m.rss_max_kib, rss);
-        m.rss_end_kib = rss;  // the last sample inside the run: the summary's own copies come after
-        if (m.rss_warm_kib == 0 && t_s >= a.soak_warmup_s) m.rss_warm_kib = rss;
-      }
-    } else if (samples % 10 == 0) {  // plots at 100 Hz
-      m.rate_xy.x.push_back(t_s);
-      m.rate_xy.y.push_back(std::hypot(r.x(), r.y()));
-      m.pan.x.push_back(t_s);
-      m.pan.y.push_back(truth->joints.pan_rad * 180 / M_PI);
-      m.tilt.x.push_back(t_s);
-      m.tilt.y.push_back(truth->joints.tilt_rad * 180 / M_PI);
-      m.centring.x.push_back(t_s);
-      m.centring.y.push_back(off.allFinite() ? off.norm() : std::nan(""));
-    }
-    return {};
+    return meter.sample(t_s);
   };
   auto loop = head::OnboardLoop::create(*model, cam, o, ports);
   if (!loop) return std::unexpected((*&loop).error());
-  // The tracker starts like `epichead track` from init.csv: the truth perturbed by 1 cm and 1 deg.
-  auto truth0 = w.truth_at(w.now_s());
-  if (!truth0) return std::unexpected(truth0.error());
-  Eigen::Isometry3d init = truth0->cam_T_obj;
-  init.linear() = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d(1, 1, 1).normalized()).toRotationMatrix() * init.linear();
-  init.translation() += Eigen::Vector3d(0.006, -0.006, 0.005);
-  (*loop)->set_initial_pose(w.now_s(), init);
+  if (detector) (*loop)->set_detector(std::move(detector));
+  if (!a.no_init) {
+    // The tracker starts like `epichead track` from init.csv: the truth perturbed by 1 cm and 1 deg.
+    auto truth0 = w.truth_at(w.now_s());
+    if (!truth0) return std::unexpected(truth0.error());
+    Eigen::Isometry3d init = truth0->cam_T_obj;
+    init.linear() = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d(1, 1, 1).normalized()).toRotationMatrix() * init.linear();
+    init.translation() += Eigen::Vector3d(0.006, -0.006, 0.005);
+    (*loop)->set_initial_pose(w.now_s(), init);
+  }
 
   int overlays = 0;
   const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
   // Sized up front (so its pages are resident before the baseline): the measuring must not grow.
   if (a.soak) m.attitude_error_deg.assign(static_cast<std::size_t>(until * scenario.fps) + 16, {0.0, 0.0});
   const head::FrameHook hook = [&](const head::TrackedFrame& f) {
-    if (a.soak) {
-      if (auto truth = w.truth_at(f.exposure_t_s)) {
-        const Eigen::Matrix3d d = f.predicted_cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
-        if (m.attitude_errors < m.attitude_error_deg.size())
-          m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
-      }
-    }
-    if (f.report->status != vision::TrackStatus::Lost) {
-      auto truth = w.truth_at(f.exposure_t_s);
-      if (truth) {
-        const Eigen::Isometry3d d = f.report->cam_T_obj * truth->cam_T_obj.inverse();
-        const double rot_deg = Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI;
-        const double t_m = (f.report->cam_T_obj.translation() - truth->cam_T_obj.translation()).norm();
-        m.succeeded += rot_deg <= 5.0 && t_m <= 0.05;
-      }
-    }
-    ++m.frames;
+    measure_frame(f, w, a, symmetries, m);
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
     overlays += write_overlay(f, *model, cam, out);
   };
   auto summary = (*loop)->run(std::min(until, w.horizon_s()), hook);
   if (!summary) return summary;
   m.attitude_error_deg.resize(m.attitude_errors);
-
-  m.cam_rate_rms_degps = samples ? std::sqrt(sq_xy / static_cast<double>(samples)) : 0;
-  m.cam_rate_rms_all_degps = samples ? std::sqrt(sq_all / static_cast<double>(samples)) : 0;
-  m.centring_rms_px = centre_n ? std::sqrt(sq_centre / static_cast<double>(centre_n)) : 0;
+  meter.finish();
   return summary;
 }
 
@@ -302,8 +349,21 @@ int run_sim_run(const SimRunArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec) return fail(cmd, "cannot create " + a.out + ": " + ec.message());
 
+  // Detection (--no-init, --reacquire) for the rendered run: the templates are built (or read)
+  // before the simulated time starts.
+  std::unique_ptr<vision::Detector> detector;
+  if (a.no_init || a.reacquire) {
+    auto model = sim::make_scene_model(scenario->scene);
+    if (!model) return fail(cmd, model.error());
+    auto camera = sim::scenario_camera(*scenario);
+    if (!camera) return fail(cmd, camera.error());
+    if (a.downscale != 1) return fail(cmd, "--no-init and --reacquire need the full-size camera (--downscale 1)");
+    auto d = make_detector(cmd, *model, *camera, a.detection, head::OnboardOptions{}.tracker);
+    if (!d) return fail(cmd, d.error());
+    detector = std::move(*d);
+  }
   RunMeasures closed, fixed, stabilised;
-  auto run = run_once(*scenario, a, mode->second, true, a.out, closed);
+  auto run = run_once(*scenario, a, mode->second, true, a.out, closed, std::move(detector));
   if (!run) return fail(cmd, run.error());
   if (a.soak) return report_soak(*scenario, a, *run, closed);
   // Fixation turns the camera on purpose (toward the target); the stabilisation figure comes
@@ -404,6 +464,10 @@ const CommandRegistration registration{
           ->check(CLI::IsMember({"simulated", "wall"}));
       app.add_option("--settle-s", a->settle_s, "Leave the first S seconds (the first slew) out of the rate RMS (default 2)")
           ->check(CLI::Range(0.0, 1e6));
+      app.add_flag("--no-init", a->no_init,
+                   "Give the loop no start pose: detection finds the object (and finds it again after a loss)");
+      app.add_flag("--reacquire", a->reacquire, "Detection finds the object again after a loss");
+      add_detection_options(app, a->detection);
       app.add_flag("--soak", a->soak,
                    "Soak run: the closed run alone (no comparison runs, bus log, timeline or plots), reporting resident "
                    "memory after --soak-warmup-s and at the end and the predictor's attitude error early and late");

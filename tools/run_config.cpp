@@ -1,5 +1,7 @@
 #include "run_config.h"
 
+#include "epichead/vision/detector.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -89,10 +91,11 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
                 d.can.receive_buffer_bytes, d.time_sync_max_round_trip_s * 1e3,
                 d.backlash.pan_rad, d.backlash.tilt_rad, d.threads.control_cpu, d.threads.vision_cpu,
                 d.threads.control_priority, d.threads.vision_priority, d.threads.lock_memory ? "true" : "false");
-  return "The configuration (JSON; relative paths from its folder; every key but the three files has\n"
-         "the default shown):\n"
+  return "The configuration (JSON; relative paths from its folder; every key but model and\n"
+         "camera_calibration is optional, with the default shown):\n"
          "  { \"model\": \"teabox/model.cao\", \"camera_calibration\": \"teabox/camera.yaml\",\n"
-         "    \"init_pose\": \"teabox/init.csv\",\n" +
+         "    \"init_pose\": \"teabox/init.csv\", \"template_cache\": \"" + vision::default_template_cache_dir() + "\",\n"
+         "    \"reacquire\": true,\n" +
          std::string(devices) + "    \"controller\": { " + gains + " },\n    \"mode\": \"" + d.mode +
          "\",\n    \"out\": \"" + d.out +
          "\" }\n"
@@ -102,7 +105,10 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "controller's gains are explained in docs/head.md; mode is fixate, stabilise or hold.\n"
          "threads: the CPU each thread is pinned to (-1: any) and its SCHED_FIFO priority (1..99; 0: normal\n"
          "scheduling); lock_memory locks the process in RAM. A refusal (no CAP_SYS_NICE or rtprio limit)\n"
-         "is reported in summary.json and the run goes on with normal scheduling (docs/head.md).\n";
+         "is reported in summary.json and the run goes on with normal scheduling (docs/head.md).\n"
+         "Without init_pose the object is detected from the model (templates cached in template_cache,\n"
+         "built once with progress on stderr); with reacquire it is detected again after a loss\n"
+         "(docs/detection.md). reacquire false with an init_pose builds no templates.\n";
 }
 
 std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
@@ -118,11 +124,19 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
   auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
   RunConfig c;
   try {
-    for (const char* key : {"model", "camera_calibration", "init_pose"})
+    for (const char* key : {"model", "camera_calibration"})
       if (!j.contains(key) || !j[key].is_string()) return std::unexpected(path + ": missing string field '" + key + "'");
     c.model = resolve(j["model"].get<std::string>());
     c.calibration = resolve(j["camera_calibration"].get<std::string>());
-    c.init_pose = resolve(j["init_pose"].get<std::string>());
+    // Without a start pose the loop detects the object (vision/detector.h).
+    for (const char* key : {"init_pose", "template_cache"})
+      if (j.contains(key) && !j[key].is_string()) return std::unexpected(path + ": '" + key + "' must be a string (a path)");
+    if (j.contains("init_pose")) c.init_pose = resolve(j["init_pose"].get<std::string>());
+    if (j.contains("template_cache")) c.template_cache = resolve(j["template_cache"].get<std::string>());
+    if (j.contains("reacquire")) {
+      if (!j["reacquire"].is_boolean()) return std::unexpected(path + ": 'reacquire' must be true or false");
+      c.reacquire = j["reacquire"].get<bool>();
+    }
     c.out = resolve(j.value("out", c.out));
     c.mode = j.value("mode", c.mode);
     auto fail = [&](const std::string& what) { return std::unexpected(path + ": " + what); };

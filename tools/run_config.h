@@ -19,7 +19,10 @@
 namespace epichead::tools {
 
 struct RunConfig {
-  std::string model, calibration, init_pose, out = "run-out", mode = "fixate";
+  std::string model, calibration, out = "run-out", mode = "fixate";
+  std::string init_pose;       // empty: the object is detected
+  std::string template_cache;  // empty: vision::default_template_cache_dir()
+  bool reacquire = true;       // detection after a loss (needs the templates)
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
   double time_sync_max_round_trip_s = head::ClockSyncOptions{}.max_round_trip_s;  // "can": time_sync_max_round_trip_ms

@@ -69,6 +69,9 @@ struct OnboardLoop::Impl {
   Eigen::Isometry3d last_good = Eigen::Isometry3d::Identity();
   double init_t_s = 0;
   bool init_pending = false;
+  bool have_pose = false;  // a start pose was given or detected
+  std::unique_ptr<vision::Detector> detector;
+  int lost_run = 0;        // lost results in a row
 
   std::optional<double> target_exposure_t_s;  // exposure time of the target given to the controller, until a command uses it
   double target_publish_t_s = 0;              // when that target was published (the processing done)
@@ -172,6 +175,9 @@ struct OnboardLoop::Impl {
     job.exposure_t_s = exposure;
     job.taken_t_s = now_s;
     job.predicted = prediction ? prediction->cam_T_obj : last_good;
+    // No start yet, or lost for a few frames: the stage looks for the object instead.
+    job.detect = detector && (!have_pose || lost_run >= options.lost_frames_before_detection);
+    job.detect_near = job.detect && have_pose;
     frame_age_ms.push(1e3 * (now_s - exposure));
     vision.submit(now_s);
     return true;
@@ -188,7 +194,7 @@ struct OnboardLoop::Impl {
       return;
     }
     const vision::FrameReport& report = *r->report;
-    track_ms.push(r->track_ms);
+    if (!r->detection) track_ms.push(r->track_ms);  // a detection is timed apart (detect_ms_max)
     ++summary.frames;
     (report.status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
     // Inline: at the modelled time the stage set; Thread: now, when the control thread takes it.
@@ -198,6 +204,20 @@ struct OnboardLoop::Impl {
     vision_latency_ms_max = std::max(vision_latency_ms_max, latency_ms);
     if (hook) hook({summary.frames - 1, r->exposure_t_s, published, r->predicted, &report, r->tracker, r->image});
     last_status = report.status;
+    count_acquisition(*r, report.status);
+    if (r->detection && r->found && report.status != vision::TrackStatus::Lost) {
+      // Found by detection: the predictor starts again from this pose, as from a start pose.
+      predictor.reset();
+      last_good = report.cam_T_obj;
+      init_t_s = r->exposure_t_s;
+      init_pending = true;
+      have_pose = true;
+      target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
+      target_exposure_t_s = r->exposure_t_s;
+      target_publish_t_s = published;
+      vision.release();
+      return;
+    }
     if (report.status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
       predictor.add_vision(r->exposure_t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
@@ -206,6 +226,24 @@ struct OnboardLoop::Impl {
       target_publish_t_s = published;
     }
     vision.release();
+  }
+
+  void count_acquisition(const VisionResult& r, vision::TrackStatus status) {
+    if (r.detection) {
+      ++summary.detections;
+      summary.detect_ms_max = std::max(summary.detect_ms_max, r.track_ms);
+      if (r.found) {
+        ++summary.detections_found;
+        if (have_pose) ++summary.reacquisitions;
+        if (summary.first_detection_t_s < 0) summary.first_detection_t_s = r.exposure_t_s;
+      }
+    }
+    if (status == vision::TrackStatus::Lost) {
+      if (lost_run == 0 && have_pose) ++summary.losses;
+      ++lost_run;
+    } else {
+      lost_run = 0;
+    }
   }
 
   void diagnose(double now_s, const ControlOutput& out) {
@@ -322,6 +360,12 @@ void OnboardLoop::set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_ob
   impl_->last_good = cam_T_obj;
   impl_->init_t_s = t_s;
   impl_->init_pending = true;
+  impl_->have_pose = true;
+}
+
+void OnboardLoop::set_detector(std::unique_ptr<vision::Detector> detector) {
+  impl_->detector = std::move(detector);
+  impl_->vision.set_detector(impl_->detector.get(), impl_->options.detection_processing_s);
 }
 
 std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, const FrameHook& hook) {

@@ -63,8 +63,30 @@ void VisionStage::track_job() {
   const auto t0 = std::chrono::steady_clock::now();
   const cv::Mat mat = as_image(job_.frame, converted_);
   result_.readable = !mat.empty() && image_.assign(mat).has_value();
-  if (result_.readable) tracker_.track(image_, job_.predicted, report_);
+  result_.detection = job_.detect && detector_ != nullptr;
+  result_.found = false;
+  if (result_.readable && result_.detection) detect_job(mat);
+  else if (result_.readable) tracker_.track(image_, job_.predicted, report_);
   result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Detection (allocates: it runs after a loss, not per frame); found: the tracker starts afresh
+// from the detected pose, and its report is the job's result.
+void VisionStage::detect_job(const cv::Mat& mat) {
+  vision::DetectionPrior prior;
+  if (job_.detect_near) prior.near_cam_T_obj = job_.predicted;
+  const auto r = detector_->detect(mat, prior);
+  result_.found = r && r->found;
+  if (!result_.found) {
+    report_.status = vision::TrackStatus::Lost;
+    report_.reasons = vision::TrackReason::NotVisible;
+    report_.cam_T_obj = job_.predicted;
+    return;
+  }
+  tracker_.reset();
+  tracker_.track(image_, r->best.cam_T_obj, report_);
+  report_.reasons = report_.reasons | vision::TrackReason::Reacquired;
+  result_.predicted = r->best.cam_T_obj;
 }
 
 void VisionStage::submit(double now_s) {
@@ -75,7 +97,8 @@ void VisionStage::submit(double now_s) {
     return;
   }
   track_job();
-  result_.done_t_s = processing_s_ >= 0 ? now_s + processing_s_ : clock_.now_s();
+  const double modelled = result_.detection ? detection_processing_s_ : processing_s_;
+  result_.done_t_s = processing_s_ >= 0 ? now_s + modelled : clock_.now_s();
 }
 
 const VisionResult* VisionStage::poll(double now_s) {

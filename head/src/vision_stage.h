@@ -27,6 +27,7 @@
 #include "epichead/head/onboard_loop.h"
 #include "epichead/hw/camera_port.h"
 #include "epichead/hw/clock.h"
+#include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/window_image.h"
 
@@ -38,6 +39,9 @@ struct VisionJob {
   double exposure_t_s = 0, taken_t_s = 0;  // the frame's exposure; when the loop took it
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
   hw::CameraFrame frame;                   // data points into the stage's own copy of the bytes
+  // Find the object instead of tracking it (the stage's detector): near `predicted` first when
+  // detect_near, else over the whole search.
+  bool detect = false, detect_near = false;
 };
 
 // What the stage gives back; valid from poll() until release().
@@ -51,6 +55,8 @@ struct VisionResult {
   const vision::FrameReport* report = nullptr;
   const vision::ModelTracker* tracker = nullptr;
   const hw::CameraFrame* image = nullptr;
+  bool detection = false;  // the job was a detection (found: the report is the tracking step from its pose)
+  bool found = false;
 };
 
 class VisionStage {
@@ -77,12 +83,21 @@ class VisionStage {
   void release();  // done with the result: the stage takes a new job
 
   double inline_wall_ms() const { return result_.track_ms; }  // Inline: wall time of the last submit's job
+  // Detection for jobs marked detect; in Inline mode its result is published
+  // detection_processing_s after submission. Set before start().
+  void set_detector(vision::Detector* detector, double detection_processing_s) {
+    detector_ = detector;
+    detection_processing_s_ = detection_processing_s;
+  }
 
  private:
   void track_job();  // the stage's work: the job's frame -> result (either thread)
   void worker_loop();
 
+  void detect_job(const cv::Mat& mat);
   vision::ModelTracker tracker_;
+  vision::Detector* detector_ = nullptr;
+  double detection_processing_s_ = 0.3;
   VisionThreads threads_;
   double processing_s_;
   const hw::Clock& clock_;

@@ -87,7 +87,8 @@ std::string default_template_cache_dir() {
 
 struct Detector::Impl {
   Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
-      : model(&m), camera(c), options(o), pull(m, c, wide(t)), tracker(m, c, t), visibility(m, c, t.visibility) {}
+      : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
+        tracker(model_storage, c, t), visibility(model_storage, c, t.visibility) {}
 
   // The pull's windows are twice as wide as tracking's: a template's pose can be off by more
   // than a frame's motion.
@@ -97,6 +98,9 @@ struct Detector::Impl {
     return t;
   }
 
+  // The detector keeps its own copy of the model: the trackers and visibility refer to it, and
+  // the caller's may go (the onboard loop takes the detector over).
+  CadModel model_storage;
   const CadModel* model;
   Camera camera;
   DetectorOptions options;

@@ -33,6 +33,7 @@
 #include "epichead/hw/camera_port.h"
 #include "epichead/hw/can_bus.h"
 #include "epichead/hw/clock.h"
+#include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
 
 namespace epichead::head {
@@ -69,6 +70,11 @@ struct OnboardOptions {
   std::string candump_path;            // empty: no recording
   std::string candump_iface = "can0";
   std::string diagnostics_path;        // JSON lines; empty: none
+  // Detection (set_detector): lost results in a row before a frame goes to detection instead of
+  // tracking (near the prediction first, then the whole search), and in Inline mode the
+  // modelled time a detection takes (a tracking step's is processing_s).
+  int lost_frames_before_detection = 3;
+  double detection_processing_s = 0.3;
 };
 
 // One tracked frame, given to the caller's hook (overlays, ground-truth comparison) on the control
@@ -115,6 +121,11 @@ struct OnboardSummary {
   ImuAssemblyCounters imu_assembly;
   ClockSyncCounters imu_clock;  // time sync with the IMU: without it no IMU sample can be placed in time
   fusion::PredictorCounters predictor;
+  // Acquisition (set_detector): detections run and how many found the object; losses (runs of
+  // lost results) and re-acquisitions by detection; when detection first found the object.
+  std::uint64_t detections = 0, detections_found = 0, losses = 0, reacquisitions = 0;
+  double first_detection_t_s = -1;
+  double detect_ms_max = 0;
 };
 
 class OnboardLoop {
@@ -128,6 +139,10 @@ class OnboardLoop {
   std::expected<OnboardSummary, std::string> run(double until_s, const FrameHook& hook = {});
   // The pose tracking starts from (init.csv on the robot, the scenario's start in the simulator).
   void set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_obj);
+  // Detection for a start without set_initial_pose() and after a loss. It runs on the vision
+  // stage like a tracking step (never on the control thread when VisionThreads::Thread); the
+  // head controller meanwhile has no fresh target and keeps to its safe mode (target_lost).
+  void set_detector(std::unique_ptr<vision::Detector> detector);
   // Ends run() after the current tick; safe from a signal handler or another thread.
   void request_stop();
 

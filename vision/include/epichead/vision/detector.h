@@ -98,7 +98,7 @@ class Detector {
  public:
   // Progress while building templates: done and total template count.
   using Progress = std::function<void(int done, int total)>;
-  // Reads the templates from `cache_dir` when a cache for this model, camera and options is
+  // The detector keeps a copy of the model. Reads the templates from `cache_dir` when a cache for this model, camera and options is
   // there, else renders them (reporting progress) and writes the cache. An empty cache_dir
   // neither reads nor writes. A cache that cannot be read is rebuilt, with a warning in
   // warnings(); one that cannot be written is a warning too.
