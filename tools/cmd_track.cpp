@@ -257,6 +257,52 @@ void warn_dropped_imu(const nlohmann::json& predictor) {
                static_cast<unsigned long long>(predictor.value("imu_saturated", std::uint64_t{0})));
 }
 
+// Detection for the start in one frame: the predictor made from the found pose (the sequence's
+// init set to it), or nothing when the object was not found.
+std::expected<std::unique_ptr<TrackPredictor>, std::string> start_from_detection(Sequence& seq, TrackAcquisition& acquisition,
+                                                                                 const cv::Mat& frame, const FrameEntry& entry,
+                                                                                 bool imu, std::optional<double> offset) {
+  const auto found = acquisition.find_start(frame, entry.frame, entry.t_s);
+  if (!found) return std::unexpected(found.error());
+  if (!*found) return std::unique_ptr<TrackPredictor>{};
+  seq.set_init({entry.frame, entry.t_s, **found, ""});
+  std::printf("frame %d: object detected; tracking from here\n", entry.frame);
+  return make_track_predictor(seq, imu, offset);
+}
+
+struct TrackCounts {
+  int tracked = 0, degraded = 0, lost = 0;
+  int searched_frames = 0;  // before detection found the start
+  int fused_frames = 0;     // frames whose poses.csv row is the filter's estimate
+  int fallback_frames = 0;  // frames measured from the vision-only extrapolation
+};
+
+// report.json's summary (per-frame entries and acquisition are added by the caller).
+nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const TrackCounts& c, const std::vector<double>& track_ms,
+                           const TrackPredictor* predictor, const ModelTracker& tracker) {
+  nlohmann::json j;
+  j["sequence"] = args.seq;
+  j["mode"] = args.mode;
+  j["imu"] = args.imu;
+  j["frames"] = frames;
+  j["tracked"] = c.tracked + c.degraded;  // a pose was output and accepted (degraded included)
+  j["tracked_clean"] = c.tracked;
+  j["degraded"] = c.degraded;
+  j["lost"] = c.lost;
+  j["track_ms_median"] = percentile(track_ms, 0.5);
+  j["track_ms_p99"] = percentile(track_ms, 0.99);
+  j["predictor"] = predictor ? predictor->diagnostics() : nlohmann::json(nullptr);
+  j["searched_frames"] = c.searched_frames;
+  j["fused_frames"] = c.fused_frames;
+  j["fallback_frames"] = c.fallback_frames;
+  if (tracker.free_turn()) {
+    const auto& a = *tracker.free_turn();
+    j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
+                           {"direction_obj", {a.direction_obj.x(), a.direction_obj.y(), a.direction_obj.z()}}};
+  }
+  return j;
+}
+
 int run_track(const TrackArgs& args) {
   const char* cmd = "track";
   static const std::map<std::string, TrackMode> modes{
@@ -286,7 +332,6 @@ int run_track(const TrackArgs& args) {
   AcquisitionOptions acquisition_options = args.acquisition;
   acquisition_options.use_imu_gravity = args.imu == "on";
   TrackAcquisition acquisition(*seq, options, acquisition_options);
-  int searched_frames = 0;
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
   WindowImage image;
@@ -301,10 +346,9 @@ int run_track(const TrackArgs& args) {
   lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n";
 
   std::vector<StampedPose> poses, vision_poses;
-  int fused_frames = 0, fallback_frames = 0;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
-  int tracked = 0, degraded = 0, lost = 0;
+  TrackCounts counts;
   std::size_t n = seq->frame_count();
   if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
   for (std::size_t i = 0; i < n; ++i) {
@@ -314,50 +358,26 @@ int run_track(const TrackArgs& args) {
     const FrameEntry& entry = seq->frames()[i];
     if (!*predictor) {
       // No start yet: detect in this frame; frames before the start have no pose.
-      const auto found = acquisition.find_start(*frame, entry.frame, entry.t_s);
-      if (!found) return fail(cmd, found.error());
-      if (!*found) {
-        ++searched_frames;
+      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset);
+      if (!started) return fail(cmd, started.error());
+      if (!*started) {
+        ++counts.searched_frames;
         per_frame.push_back({{"frame", entry.frame}, {"t_s", entry.t_s}, {"status", "searching"}});
         continue;
       }
-      seq->set_init({entry.frame, entry.t_s, **found, ""});
-      predictor = make_track_predictor(*seq, args.imu == "on", *offset);
-      if (!predictor) return fail(cmd, predictor.error());
-      std::printf("frame %d: object detected; tracking from here\n", entry.frame);
+      predictor = std::move(*started);
     }
-    Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
+    const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
     const std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
-    if (acquisition.after_frame(report.status)) {
-      // Lost for a few frames: look for the object again, near the prediction first.
-      const auto found = acquisition.find_again(*frame, entry.frame, entry.t_s, predicted);
-      if (!found) return fail(cmd, found.error());
-      if (*found) {
-        tracker.reset();
-        (*predictor)->restart(entry.t_s, **found);
-        predicted = **found;
-        tracker.track(image, predicted, report);
-        report.reasons = report.reasons | TrackReason::Reacquired;
-      }
-    }
-    if (report.status != TrackStatus::Lost && acquisition.recheck_due(entry.t_s)) {
-      // A detected start is provisional: a pose that explains much more of the image takes over.
-      const auto better = acquisition.recheck(*frame, entry.t_s, report.cam_T_obj);
-      if (!better) return fail(cmd, better.error());
-      if (*better) {
-        tracker.reset();
-        (*predictor)->restart(entry.t_s, **better);
-        tracker.track(image, **better, report);
-        report.reasons = report.reasons | TrackReason::Reacquired;
-      }
-    }
-    fallback_frames += report.used_fallback;
+    if (auto ok = acquisition.after_tracking(*frame, image, entry.t_s, predicted, tracker, **predictor, report); !ok)
+      return fail(cmd, ok.error());
+    counts.fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
     track_ms.push_back(report.times.total_ms);
-    tracked += report.status == TrackStatus::Tracked;
-    degraded += report.status == TrackStatus::Degraded;
-    lost += report.status == TrackStatus::Lost;
+    counts.tracked += report.status == TrackStatus::Tracked;
+    counts.degraded += report.status == TrackStatus::Degraded;
+    counts.lost += report.status == TrackStatus::Lost;
     // With the IMU the output is the filter's estimate at the exposure time: a pose from a few
     // blurred lines is weighed against the gyro's propagation (box_clutter at jerk 2: 98 -> 100 %).
     // The pose estimator's own result stays in vision_poses.csv.
@@ -365,7 +385,7 @@ int run_track(const TrackArgs& args) {
     if (report.status != TrackStatus::Lost)
       if (const auto f = (*predictor)->fused(entry.t_s)) {
         estimate = *f;
-        ++fused_frames;
+        ++counts.fused_frames;
       }
     poses.push_back({entry.frame, entry.t_s, estimate, to_string(report.status)});
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
@@ -386,27 +406,9 @@ int run_track(const TrackArgs& args) {
   if (args.imu == "on")
     if (auto ok = write_pose_csv((fs::path(args.out) / "vision_poses.csv").string(), vision_poses); !ok)
       return fail(cmd, ok.error());
-  nlohmann::json j;
-  j["sequence"] = args.seq;
-  j["mode"] = args.mode;
-  j["imu"] = args.imu;
-  j["frames"] = n;
-  j["tracked"] = tracked + degraded;  // a pose was output and accepted (degraded included)
-  j["tracked_clean"] = tracked;
-  j["degraded"] = degraded;
-  j["lost"] = lost;
-  j["track_ms_median"] = percentile(track_ms, 0.5);
-  j["track_ms_p99"] = percentile(track_ms, 0.99);
-  j["predictor"] = *predictor ? (*predictor)->diagnostics() : nlohmann::json(nullptr);
+  nlohmann::json j = report_json(args, n, counts,
+                                 track_ms, *predictor ? predictor->get() : nullptr, tracker);
   j["acquisition"] = acquisition.to_json();
-  j["searched_frames"] = searched_frames;  // frames before detection found the start
-  j["fused_frames"] = fused_frames;
-  j["fallback_frames"] = fallback_frames;  // frames measured from the vision-only extrapolation
-  if (tracker.free_turn()) {
-    const auto& a = *tracker.free_turn();
-    j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
-                           {"direction_obj", {a.direction_obj.x(), a.direction_obj.y(), a.direction_obj.z()}}};
-  }  // frames whose poses.csv row is the filter's estimate
   if (!overlays.video_note().empty()) j["video_note"] = overlays.video_note();
   j["per_frame"] = std::move(per_frame);
   const std::string report_path = (fs::path(args.out) / "report.json").string();
@@ -414,7 +416,7 @@ int run_track(const TrackArgs& args) {
   rep << j.dump(1) << '\n';
   if (!rep.flush()) return fail(cmd, "cannot write " + report_path);
   std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost; tracking %.3f ms median, %.3f ms p99\n", n,
-              args.mode.c_str(), args.imu.c_str(), tracked, degraded, lost, percentile(track_ms, 0.5),
+              args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, percentile(track_ms, 0.5),
               percentile(track_ms, 0.99));
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
               args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");

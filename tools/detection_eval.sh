@@ -5,6 +5,7 @@
 # (detection finds the start and re-acquires after losses) beside the same run from init.csv.
 # Scored up to the model's symmetries (a box's half turns) and, for bodies of revolution, the
 # turn about their axis. Writes DIR/rows.tsv and DIR/section.md (the table in docs/detection.md).
+# Runs already in DIR/rows are kept, so an interrupted evaluation resumes where it stopped.
 # Usage: tools/detection_eval.sh [--dev "1 2 3"] [--held "101 ... 112"] [--scenarios "a b"]
 #                                [--frames N] [--jobs J] [--out DIR] [--bin PATH]
 #   --scenarios   default: mockup_walk box_clutter lampshade can bowl (office_pan's model is the
@@ -47,6 +48,8 @@ score_args() {
 #   success_no_init success_init reacquisitions losses start_frame
 one() {
   local scenario="$1" seed="$2" set="$3"
+  # A run already done is kept (an interrupted evaluation resumes; delete DIR/rows to redo it).
+  [[ -s "$out/rows/$scenario-$seed.tsv" ]] && return 0
   local seq="$out/seq/$scenario-$seed" work="$out/run/$scenario-$seed"
   rm -rf "$seq" "$work"
   mkdir -p "$work"
@@ -82,12 +85,15 @@ one() {
 export -f one score_args
 export bin out frames
 
+runs() {  # scenario seed set, one per line
+  for s in $dev; do echo "$1 $s dev"; done
+  for s in $held; do echo "$1 $s held"; done
+}
 for scenario in $scenarios; do
-  first=$(echo $dev | cut -d' ' -f1)
   echo "detection_eval: $scenario (templates are built once, then read from $EPICHEAD_CACHE_DIR)" >&2
-  one "$scenario" "$first" dev  # builds the template cache before the parallel runs
-  { for s in $dev; do [[ $s != "$first" ]] && echo "$scenario $s dev"; done
-    for s in $held; do echo "$scenario $s held"; done; } | xargs -P "$jobs" -L 1 bash -c 'one "$0" "$1" "$2"'
+  # The first run alone builds the template cache; the others read it, in parallel.
+  runs "$scenario" | head -1 | xargs -L 1 bash -c 'one "$0" "$1" "$2"'
+  runs "$scenario" | tail -n +2 | xargs -r -P "$jobs" -L 1 bash -c 'one "$0" "$1" "$2"'
 done
 cat "$out"/rows/*.tsv | sort -k1,1 -k2,2n > "$out/rows.tsv"
 

@@ -26,6 +26,9 @@ void add_detection_options(CLI::App& app, DetectionArgs& a) {
   app.add_option("--views", a.options.view_subdivisions,
                  "Detection: view sphere subdivisions (1: 42 views, 2: 162, 3: 642)")
       ->check(CLI::Range(0, 4));
+  app.add_option("--hypotheses", a.options.max_hypotheses,
+                 "Detection: hypotheses refined and verified per search (more: slower, finds more)")
+      ->check(CLI::Range(1, 10000));
   app.add_option("--min-support", a.options.min_support,
                  "Detection: share of the model's outline an image edge must support for a pose to count as found")
       ->check(CLI::Range(0.0, 1.0));

@@ -1,7 +1,5 @@
 #include "run_config.h"
 
-#include "epichead/vision/detector.h"
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -94,7 +92,7 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
   return "The configuration (JSON; relative paths from its folder; every key but model and\n"
          "camera_calibration is optional, with the default shown):\n"
          "  { \"model\": \"teabox/model.cao\", \"camera_calibration\": \"teabox/camera.yaml\",\n"
-         "    \"init_pose\": \"teabox/init.csv\", \"template_cache\": \"" + vision::default_template_cache_dir() + "\",\n"
+         "    \"init_pose\": \"teabox/init.csv\", \"template_cache\": \"~/.cache/epichead\",\n"
          "    \"reacquire\": true,\n" +
          std::string(devices) + "    \"controller\": { " + gains + " },\n    \"mode\": \"" + d.mode +
          "\",\n    \"out\": \"" + d.out +
@@ -106,7 +104,8 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "threads: the CPU each thread is pinned to (-1: any) and its SCHED_FIFO priority (1..99; 0: normal\n"
          "scheduling); lock_memory locks the process in RAM. A refusal (no CAP_SYS_NICE or rtprio limit)\n"
          "is reported in summary.json and the run goes on with normal scheduling (docs/head.md).\n"
-         "Without init_pose the object is detected from the model (templates cached in template_cache,\n"
+         "Without init_pose the object is detected from the model (templates cached in template_cache;\n"
+         "by default $EPICHEAD_CACHE_DIR, else $XDG_CACHE_HOME/epichead, else ~/.cache/epichead;\n"
          "built once with progress on stderr); with reacquire it is detected again after a loss\n"
          "(docs/detection.md). reacquire false with an init_pose builds no templates.\n";
 }

@@ -91,6 +91,28 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
   return found;
 }
 
+std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat& frame, const vision::WindowImage& image,
+                                                                  double t_s, const Eigen::Isometry3d& predicted,
+                                                                  vision::ModelTracker& tracker, TrackPredictor& predictor,
+                                                                  vision::FrameReport& report) {
+  std::optional<Eigen::Isometry3d> found;
+  if (after_frame(report.status)) {
+    auto again = find_again(frame, 0, t_s, predicted);
+    if (!again) return std::unexpected(again.error());
+    found = *again;
+  } else if (report.status != vision::TrackStatus::Lost && recheck_due(t_s)) {
+    auto better = recheck(frame, t_s, report.cam_T_obj);
+    if (!better) return std::unexpected(better.error());
+    found = *better;
+  }
+  if (!found) return {};
+  tracker.reset();
+  predictor.restart(t_s, *found);
+  tracker.track(image, *found, report);
+  report.reasons = report.reasons | vision::TrackReason::Reacquired;
+  return {};
+}
+
 nlohmann::json TrackAcquisition::to_json() const {
   std::vector<double> ms = detect_ms_;
   std::sort(ms.begin(), ms.end());

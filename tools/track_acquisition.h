@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "detection_setup.h"
+#include "track_prediction.h"
 #include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/sequence.h"
@@ -46,6 +47,12 @@ class TrackAcquisition {
   // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
   std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, int frame_number, double t_s,
                                                                           const Eigen::Isometry3d& predicted);
+  // After the frame's tracking step (report): detection when the object has been lost for a few
+  // frames (near `predicted` first), and the provisional start's recheck. When either finds a
+  // pose, the tracker and the predictor restart from it and the frame is measured again.
+  std::expected<void, std::string> after_tracking(const cv::Mat& frame, const vision::WindowImage& image, double t_s,
+                                                  const Eigen::Isometry3d& predicted, vision::ModelTracker& tracker,
+                                                  TrackPredictor& predictor, vision::FrameReport& report);
   // While a detected start is provisional and a recheck is due at t_s: the whole search on
   // this frame, and the pose to switch to when it explains a much longer outline than `tracked`.
   bool recheck_due(double t_s) const;

@@ -162,11 +162,33 @@ def run_config(out):
   "mode": "fixate", "out": "run-out" }
 """)
     write(out, "run_config", "minimal", '{"model":"m.cao","camera_calibration":"/abs/c.yaml","init_pose":"i.csv"}')
+    write(out, "run_config", "detect", '{"model":"m.cao","camera_calibration":"c.yaml","reacquire":false,"template_cache":"t"}')
+
+
+def template_record(view, roll, dist, distance_m, dx, dy, levels):
+    b = struct.pack("<iiifffB", view, roll, dist, distance_m, dx, dy, len(levels))
+    for level, (w, h, feats) in enumerate(levels):
+        b += struct.pack("<iiiI", w, h, level, len(feats))
+        for x, y, label in feats:
+            b += struct.pack("<hhB", x, y, label)
+    return b
+
+
+def template_cache(out):
+    # vision/src/template_cache.h's layout: a real cache is megabytes; these hold its every part.
+    def cache(key, records):
+        return b"EPHDTPL1" + struct.pack("<QI", key, len(records)) + b"".join(records)
+    r1 = template_record(3, 5, 1, 0.45, 12.5, -3.0, [(60, 40, [(k * 3, k * 2, k % 8) for k in range(10)]),
+                                                       (30, 20, [(k, k, k % 8) for k in range(5)])])
+    r2 = template_record(160, 23, 7, 1.25, 40.0, 33.0, [(20, 20, [(0, 0, 0), (20, 20, 7)])])
+    write(out, "template_cache", "two_templates", cache(0x1234, [r1, r2]))
+    write(out, "template_cache", "one_template", cache(7, [r2]))
+    write(out, "template_cache", "truncated", cache(7, [r1])[:-5])
 
 
 def main():
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "build-fuzz" / "seeds"
-    for make in (cao, camera, csvs, candump, can_protocol, dronecan, hid, scenario, run_config):
+    for make in (cao, camera, csvs, candump, can_protocol, dronecan, hid, scenario, run_config, template_cache):
         make(out)
 
 

@@ -94,3 +94,23 @@ TEST_CASE("run --help lists the configuration keys and the controller's gains") 
   // The defaults shown are the controller's own.
   CHECK(r.out.find("\"stabilise_gain_per_s\": 60") != std::string::npos);
 }
+
+TEST_CASE("run config: without init_pose the object is detected, reacquire is a bool, template_cache a path") {
+  TempDir dir;
+  const auto plain = read_run_config(dir.write("a.json", R"({ "model": "m.cao", "camera_calibration": "c.yaml" })"));
+  REQUIRE(plain);
+  CHECK(plain->init_pose.empty());
+  CHECK(plain->reacquire);
+  CHECK(plain->template_cache.empty());
+  const auto set = read_run_config(dir.write(
+      "b.json", R"({ "model": "m.cao", "camera_calibration": "c.yaml", "reacquire": false, "template_cache": "cache" })"));
+  REQUIRE(set);
+  CHECK_FALSE(set->reacquire);
+  CHECK(set->template_cache == (std::filesystem::path(dir.path) / "cache").string());
+  const auto bad = read_run_config(dir.write("c.json", R"({ "model": "m.cao", "camera_calibration": "c.yaml", "reacquire": 1 })"));
+  REQUIRE_FALSE(bad);
+  CHECK(bad.error().find("'reacquire' must be true or false") != std::string::npos);
+  const auto bad_path = read_run_config(dir.write("d.json", R"({ "model": "m.cao", "camera_calibration": "c.yaml", "init_pose": 3 })"));
+  REQUIRE_FALSE(bad_path);
+  CHECK(bad_path.error().find("'init_pose' must be a string") != std::string::npos);
+}

@@ -1,0 +1,130 @@
+// Detection without a starting pose, end to end through the program: `detect` on the real tea
+// box video, `track` of the real video with init.csv removed, and re-acquisition after a
+// one-second cover in the simulator. The templates (a coarse view sphere, --views 1, to keep
+// the sanitizer build quick) are shared by these tests in the build tree's cache.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common/run_tool.h"
+#include "common/temp_dir.h"
+
+using epichead::testing::run_epichead;
+using epichead::testing::slurp;
+using epichead::testing::TempDir;
+
+namespace {
+namespace fs = std::filesystem;
+const auto& q = epichead::testing::shell_quoted;
+const std::string kCache = std::string(" --views 1 --cache-dir ") + EPICHEAD_TEMPLATE_CACHE;
+const std::string kTeabox = std::string(EPICHEAD_SHARED_DATA) + "/teabox";
+
+// A copy of a real sequence without its init.csv.
+std::string without_init(const TempDir& tmp, const std::string& name) {
+  const std::string dir = tmp / name;
+  fs::create_directories(dir);
+  for (const auto& e : fs::directory_iterator(std::string(EPICHEAD_SHARED_DATA) + "/" + name))
+    if (e.is_regular_file() && e.path().filename() != "init.csv") fs::copy_file(e.path(), fs::path(dir) / e.path().filename());
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("detect finds the real tea box in the first frame from the model alone, and caches its templates") {
+  TempDir tmp("epichead_test_detect_teabox");
+  const std::string out = tmp / "det";
+  const auto run = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(out) + kCache);
+  INFO(run.out << run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(out + "/detection.json"));
+  CHECK(j["found"] == true);
+  CHECK(j["best"]["support"].get<double>() > 0.7);
+  CHECK(fs::exists(j["template_cache"].get<std::string>()));
+  CHECK(fs::exists(out + "/detection.png"));
+  // The pose against ViSP's on this frame, up to the box's half turns (a plain box's wire-frame
+  // cannot tell them apart).
+  const auto score = run_epichead(tmp, "score " + q(kTeabox) + " " + q(out + "/pose.csv") + " --reference " +
+                                           q(kTeabox + "/reference_visp.csv") + " --symmetric --json");
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["succeeded"] == 1);
+  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
+  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+
+  SECTION("the second run reads the templates from the cache; a garbled cache is rebuilt with a warning") {
+    const auto again = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 10 --out " + q(out) + kCache);
+    REQUIRE(again.exit_code == 0);
+    CHECK(nlohmann::json::parse(slurp(out + "/detection.json"))["templates_from_cache"] == true);
+    const std::string cache = j["template_cache"].get<std::string>();
+    const std::string saved = slurp(cache);
+    std::ofstream(cache, std::ios::binary | std::ios::trunc) << "EPHDTPL1 not really";
+    const auto rebuilt = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(out) + kCache);
+    CHECK(rebuilt.exit_code == 0);
+    CHECK(rebuilt.err.find("templates rebuilt") != std::string::npos);
+    CHECK(slurp(cache).size() == saved.size());
+  }
+}
+
+TEST_CASE("detect: a frame out of range, a bad --object-up and --imu on without imu.csv are errors naming the problem") {
+  TempDir tmp("epichead_test_detect_errors");
+  const auto range = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 999 --out " + q(tmp / "o") + kCache);
+  CHECK(range.exit_code == 1);
+  CHECK(range.err.find("--frame 999 out of range (the sequence has 39 frames)") != std::string::npos);
+  const auto up = run_epichead(tmp, "detect " + q(kTeabox) + " --object-up 0,0 --out " + q(tmp / "o") + kCache);
+  CHECK(up.exit_code == 1);
+  CHECK(up.err.find("--object-up must be x,y,z") != std::string::npos);
+  const auto imu = run_epichead(tmp, "detect " + q(kTeabox) + " --imu on --out " + q(tmp / "o") + kCache);
+  CHECK(imu.exit_code == 1);
+  CHECK(imu.err.find("--imu on needs imu.csv") != std::string::npos);
+}
+
+TEST_CASE("track without init.csv detects the tea box and follows the real teabox_left video") {
+  TempDir tmp("epichead_test_track_no_init");
+  const std::string seq = without_init(tmp, "teabox_left"), out = tmp / "track";
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video" + kCache);
+  INFO(run.out << run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  CHECK(report["acquisition"]["start"]["frame"] == 0);
+  CHECK(report["searched_frames"] == 0);
+  const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --reference " +
+                                           q(seq + "/reference_visp.csv") + " --symmetric --json");
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["success_rate"].get<double>() >= 0.99);
+  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
+}
+
+TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it") {
+  TempDir tmp("epichead_test_track_cover");
+  const std::string seq = tmp / "box_cover", out = tmp / "track";
+  // 4.5 s: the board slides in at 2.2 s, hides everything from 2.5 s to 3.5 s and is gone at 3.8 s.
+  REQUIRE(run_epichead(tmp, "sim box_cover --out " + q(seq) + " --frames 135").exit_code == 0);
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video" + kCache);
+  INFO(run.out << run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto acq = nlohmann::json::parse(slurp(out + "/report.json"))["acquisition"];
+  INFO(acq.dump());
+  CHECK(acq["losses"].get<int>() >= 1);
+  CHECK(acq["reacquisitions"].get<int>() >= 1);
+  REQUIRE(acq["frames_to_reacquire"].size() >= 1);
+  const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --symmetric --per-frame " +
+                                           q(tmp / "per_frame.csv") + " --json");
+  REQUIRE(score.exit_code == 0);
+  // Every frame after the board has gone (3.8 s, frame 108) plus the few to find it again.
+  std::ifstream per_frame(tmp / "per_frame.csv");
+  std::string line;
+  std::getline(per_frame, line);
+  int after = 0, right_after = 0;
+  while (std::getline(per_frame, line)) {
+    const int frame = std::stoi(line);
+    if (frame < 115) continue;
+    ++after;
+    right_after += line.find(',' + std::string("1,1,")) == line.find(',');  // frame,present,success,...
+  }
+  CHECK(after == 20);
+  CHECK(right_after >= 19);
+}

@@ -1,0 +1,144 @@
+// The pieces of detection (vision/detector.h) that can be checked without a search: the view
+// sphere, the template cache's file format against bad bytes, edge support on drawn outlines,
+// and the model symmetries that scoring removes.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "edge_drawing.h"
+#include "edge_support.h"
+#include "epichead/vision/cao_model.h"
+#include "epichead/vision/offline/model_symmetry.h"
+#include "epichead/vision/visibility.h"
+#include "template_cache.h"
+#include "view_sphere.h"
+
+using namespace epichead::vision;
+using namespace epichead::vision::detail;
+
+namespace {
+
+CadModel box(double x, double y, double z) {
+  RawModel raw;
+  raw.vertices = {{0, 0, 0}, {x, 0, 0}, {x, y, 0}, {0, y, 0}, {0, 0, z}, {x, 0, z}, {x, y, z}, {0, y, z}};
+  raw.face_loops = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  auto m = build_model(raw, "box");
+  REQUIRE(m);
+  return *m;
+}
+
+Camera camera() { return Camera(640, 480, Intrinsics{600, 600, 320, 240}); }
+
+Eigen::Isometry3d looking_at_box(double distance_m) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = look_rotation(Eigen::Vector3d(1, -2, 1.5).normalized(), 0.3);
+  T.translation() = Eigen::Vector3d(0.02, -0.01, distance_m) - T.linear() * Eigen::Vector3d(0.08, 0.03, 0.04);
+  return T;
+}
+
+}  // namespace
+
+TEST_CASE("view sphere: 12, 42 and 162 unit directions, evenly spread") {
+  CHECK(view_directions(0).size() == 12);
+  CHECK(view_directions(1).size() == 42);
+  const auto v = view_directions(2);
+  REQUIRE(v.size() == 162);
+  double nearest_max = 0;
+  for (const auto& a : v) {
+    CHECK(std::abs(a.norm() - 1) < 1e-12);
+    double nearest = 10;
+    for (const auto& b : v)
+      if (&a != &b) nearest = std::min(nearest, std::acos(std::clamp(a.dot(b), -1.0, 1.0)));
+    nearest_max = std::max(nearest_max, nearest);
+  }
+  CHECK(nearest_max * 180 / M_PI < 20.0);  // no direction further than 20 deg from its neighbour
+}
+
+TEST_CASE("look rotation: the camera on the view direction looks at the object, turned by the roll") {
+  for (const auto& from : view_directions(1)) {
+    const Eigen::Matrix3d R = look_rotation(from, 0.7);
+    CHECK((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-12);
+    CHECK(std::abs(R.determinant() - 1) < 1e-12);
+    // The direction toward the object is the camera's optical axis.
+    CHECK((R * -from - Eigen::Vector3d::UnitZ()).norm() < 1e-9);
+  }
+  const Eigen::Matrix3d a = look_rotation(Eigen::Vector3d(1, 0, 0), 0), b = look_rotation(Eigen::Vector3d(1, 0, 0), 0.5);
+  CHECK(std::abs(Eigen::AngleAxisd(b * a.transpose()).angle() - 0.5) < 1e-9);
+}
+
+TEST_CASE("template cache: what is written reads back, and truncated, garbled or stale bytes are errors") {
+  std::vector<TemplateRecord> records(2);
+  records[0].spec = {3, 5, 1, 0.45f, 12.5f, -3.0f};
+  records[1].spec = {160, 23, 7, 1.25f, 40.0f, 33.0f};
+  for (auto& r : records)
+    for (int level = 0; level < 2; ++level) {
+      cv::linemod::Template t;
+      t.width = 60 >> level;
+      t.height = 40 >> level;
+      t.pyramid_level = level;
+      for (int k = 0; k < 10; ++k) t.features.emplace_back(k * 3 >> level, k * 2 >> level, k % 8);
+      r.levels.push_back(t);
+    }
+  const std::string bytes = encode_template_cache(42, records);
+  const auto back = decode_template_cache(bytes, 42, "cache");
+  REQUIRE(back);
+  REQUIRE(back->size() == 2);
+  CHECK((*back)[1].spec.view == 160);
+  CHECK((*back)[1].spec.distance_m == 1.25f);
+  CHECK((*back)[0].levels[1].features[9].label == 1);
+  CHECK(encode_template_cache(42, *back) == bytes);
+
+  CHECK(decode_template_cache(bytes, 43, "cache").error() == "cache: made for another model, camera or options");
+  for (std::size_t cut : {std::size_t{3}, std::size_t{20}, bytes.size() / 2, bytes.size() - 1}) {
+    CAPTURE(cut);
+    CHECK_FALSE(decode_template_cache(bytes.substr(0, cut), 42, "cache"));
+  }
+  CHECK(decode_template_cache(bytes + "x", 42, "cache").error() == "cache: trailing bytes after the last template");
+  std::string bad_label = bytes;
+  bad_label[bad_label.size() - 1] = 9;  // the last feature's label: linemod has 8
+  CHECK(decode_template_cache(bad_label, 42, "cache").error() == "cache: template 1: feature out of range");
+}
+
+TEST_CASE("edge support: a drawn outline supports its own pose fully, a blank image or a shifted pose not") {
+  const CadModel model = box(0.165, 0.068, 0.08);
+  const Camera cam = camera();
+  Visibility visibility(model, cam);
+  VisibleModel seen;
+  const Eigen::Isometry3d T = looking_at_box(0.5);
+  visibility.compute(T, seen);
+  const EdgeDrawing drawing = draw_edges(seen, cam, 4);
+  REQUIRE_FALSE(drawing.empty);
+  cv::Mat grey = cv::Mat::zeros(cam.height_px(), cam.width_px(), CV_8UC1);
+  cv::Mat drawn;
+  cv::cvtColor(drawing.bgr, drawn, cv::COLOR_BGR2GRAY);
+  drawn.copyTo(grey(cv::Rect(drawing.origin, drawn.size())));
+  EdgeGradients g;
+  g.compute(grey);
+  const EdgeSupport at_pose = edge_support(g, seen);
+  CHECK(at_pose.share > 0.95);
+  CHECK(at_pose.samples > 100);
+
+  Eigen::Isometry3d shifted = T;
+  shifted.translation().x() += 0.03;  // ~36 px to the side
+  VisibleModel there;
+  visibility.compute(shifted, there);
+  CHECK(edge_support(g, there).share < 0.3);
+
+  EdgeGradients blank;
+  blank.compute(cv::Mat::zeros(cam.height_px(), cam.width_px(), CV_8UC1));
+  CHECK(edge_support(blank, seen).share == 0.0);
+}
+
+TEST_CASE("model symmetries: a box of three different sides has three half turns, a wedge none") {
+  const auto turns = model_symmetries(box(0.165, 0.068, 0.08));
+  REQUIRE(turns.size() == 3);
+  for (const auto& S : turns) CHECK(std::abs(Eigen::AngleAxisd(S.linear()).angle() - M_PI) < 1e-9);
+  RawModel wedge;
+  wedge.vertices = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.05, 0}, {0, 0, 0.02}, {0.1, 0, 0.02}, {0, 0.05, 0.02}};
+  wedge.face_loops = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+  auto w = build_model(wedge, "wedge");
+  REQUIRE(w);
+  CHECK(model_symmetries(*w).empty());
+}

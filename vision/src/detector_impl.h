@@ -1,0 +1,103 @@
+#pragma once
+// The detector's state, shared by the two files that implement it: detector_templates.cpp
+// (the view grid, rendering, the cache, create()) and detector.cpp (matching, candidates,
+// refinement and verification, detect()).
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/rgbd/linemod.hpp>
+
+#include "edge_support.h"
+#include "epichead/vision/detector.h"
+#include "template_cache.h"
+
+namespace epichead::vision {
+
+namespace detail {
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+// LINE-2D's class of a view and turn: its templates are the distances.
+inline std::string class_id(int view, int roll) { return "v" + std::to_string(view) + "r" + std::to_string(roll); }
+}  // namespace detail
+
+struct Detector::Impl {
+  Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
+      : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
+        tracker(model_storage, c, t), visibility(model_storage, c, t.visibility) {}
+
+  // The pull's windows are twice as wide as tracking's: a template's pose can be off by more
+  // than a frame's motion.
+  static ModelTrackerOptions wide(ModelTrackerOptions t) {
+    t.lines.window.width_px = std::min(kMaxWindowWidth, 2 * t.lines.window.width_px);
+    t.max_jump_px = 2 * t.max_jump_px;
+    return t;
+  }
+
+  // The detector keeps its own copy of the model: the trackers and visibility refer to it, and
+  // the caller's may go (the onboard loop takes the detector over).
+  CadModel model_storage;
+  const CadModel* model;
+  Camera camera;
+  DetectorOptions options;
+  // A template's pose is up to half a grid step off in view, turn and distance: a tracker with
+  // wide windows pulls it in first; the caller's tracker then measures it as tracking will.
+  ModelTracker pull;
+  ModelTracker tracker;
+  Visibility visibility;
+  VisibleModel visible;
+  WindowImage window_image;
+  detail::EdgeGradients gradients;
+  cv::Ptr<cv::linemod::Detector> line2d;
+  std::vector<Eigen::Vector3d> views;
+  std::vector<double> rolls_rad;
+  std::vector<double> distances_m;
+  std::vector<detail::TemplateSpec> specs;
+  std::map<std::string, std::vector<int>> class_specs;  // class id -> spec index per template id
+  Eigen::Vector3d centre_obj = Eigen::Vector3d::Zero();
+  double radius_m = 0;
+  std::vector<Eigen::Vector3d> outline_obj;  // model points whose projections stand for a pose's outline
+  std::vector<Eigen::Vector2d> scratch_outline;
+
+  void project_outline(const Eigen::Isometry3d& T, std::vector<Eigen::Vector2d>& px) const {
+    px.clear();
+    for (const auto& p : outline_obj) {
+      const Eigen::Vector3d q = T * p;
+      if (q.z() > 1e-6) px.push_back(camera.project(q));
+    }
+  }
+  std::string cache_path;
+  bool from_cache = false;
+  double build_s = 0;
+  std::vector<std::string> warnings;
+
+  std::uint64_t key() const;
+  // LINE-2D on colour gradients (a drawing of white edges gives the same orientations as a
+  // grey frame's gradients, and the matcher takes BGR): T = 5 px at full resolution, 8 px at half.
+  cv::Ptr<cv::linemod::Detector> make_matcher() const {
+    std::vector<cv::Ptr<cv::linemod::Modality>> modalities{
+        cv::makePtr<cv::linemod::ColorGradient>(10.0f, static_cast<std::size_t>(options.features_per_template), 55.0f)};
+    return cv::makePtr<cv::linemod::Detector>(modalities, std::vector<int>{5, 8});
+  }
+  void grids();
+  std::vector<detail::TemplateRecord> render(const Progress& progress);
+  void load(const std::vector<detail::TemplateRecord>& records);
+  Eigen::Isometry3d template_pose(int view, int roll, double distance_m) const;
+  std::vector<std::string> classes_for(const DetectionPrior& prior) const;
+  std::vector<Eigen::Isometry3d> hypotheses(const std::vector<cv::linemod::Match>& matches, const DetectionPrior& prior,
+                                            std::vector<float>& similarity);
+  DetectionHypothesis refine(const Eigen::Isometry3d& start, float similarity);
+  // Support, score and outline length of h's pose on the current frame (gradients).
+  // whole_object: a pose with part of the model outside the image scores 0 (detections).
+  DetectionHypothesis measure(DetectionHypothesis h, bool whole_object = true);
+  // Takes a frame: the matcher's BGR (padded), the grey gradients and the tracker's image.
+  std::expected<cv::Mat, std::string> take_frame(const cv::Mat& frame);
+  bool verified(const DetectionHypothesis& h) const {
+    return h.support >= options.min_support && h.supported_px >= options.min_supported_px;
+  }
+};
+
+
+}  // namespace epichead::vision
