@@ -340,10 +340,8 @@ int run_track(const TrackArgs& args) {
 
   // Per frame and visible model edge, the candidate the tracker selected: what `epichead score
   // --lines` checks against the ground truth (did the tracker pick the right edge?).
-  const std::string lines_path = (fs::path(args.out) / "lines.csv").string();
-  std::ofstream lines_csv(lines_path);
-  if (!lines_csv) return fail(cmd, "cannot write " + lines_path);
-  lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n";
+  std::ofstream lines_csv((fs::path(args.out) / "lines.csv").string());
+  if (!(lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n")) return fail(cmd, "cannot write " + args.out + "/lines.csv");
 
   std::vector<StampedPose> poses, vision_poses;
   std::vector<double> track_ms;

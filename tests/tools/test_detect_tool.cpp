@@ -98,7 +98,7 @@ TEST_CASE("track without init.csv detects the tea box and follows the real teabo
   CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
 }
 
-TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it") {
+TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it; gravity narrows detection") {
   TempDir tmp("epichead_test_track_cover");
   const std::string seq = tmp / "box_cover", out = tmp / "track";
   // 4.5 s: the board slides in at 2.2 s, hides everything from 2.5 s to 3.5 s and is gone at 3.8 s.
@@ -127,4 +127,16 @@ TEST_CASE("track finds the package again after a board hides it for a second (bo
   }
   CHECK(after == 20);
   CHECK(right_after >= 19);
+
+  // With the IMU and the package's up (its model's z), gravity leaves a fraction of the views
+  // to match, and the package is found in the first frame all the same.
+  const auto det = run_epichead(tmp, "detect " + q(seq) + " --frame 0 --imu on --object-up 0,0,1 --out " + q(tmp / "det") + kCache);
+  INFO(det.err);
+  REQUIRE(det.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(tmp / "det/detection.json"));
+  CHECK(j["gravity_used"] == true);
+  CHECK(j["templates_matched"].get<int>() < j["templates"].get<int>() / 2);
+  const auto one = run_epichead(tmp, "score " + q(seq) + " " + q(tmp / "det/pose.csv") + " --symmetric --json");
+  REQUIRE(one.exit_code == 0);
+  CHECK(nlohmann::json::parse(one.out)["succeeded"] == 1);
 }
