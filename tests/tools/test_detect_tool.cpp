@@ -98,7 +98,7 @@ TEST_CASE("track without init.csv detects the tea box and follows the real teabo
   CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
 }
 
-TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it; gravity narrows detection") {
+TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it, and gravity narrows detection") {
   TempDir tmp("epichead_test_track_cover");
   const std::string seq = tmp / "box_cover", out = tmp / "track";
   // 4.5 s: the board slides in at 2.2 s, hides everything from 2.5 s to 3.5 s and is gone at 3.8 s.
