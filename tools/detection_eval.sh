@@ -11,6 +11,7 @@
 #   --scenarios   default: mockup_walk box_clutter lampshade can bowl (office_pan's model is the
 #                 room around the camera: it is never wholly in view, which detection needs)
 #   --frames N    frames per sequence (default 90)
+#   --table-only  only make the table from the rows in DIR (of a run still going, or stopped)
 # Needs jq.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -21,6 +22,7 @@ scenarios="mockup_walk box_clutter lampshade can bowl"
 frames=90
 jobs=$(nproc)
 out="$here/out/detection_eval"
+table_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --dev) dev="$2"; shift 2 ;;
@@ -30,7 +32,8 @@ while [[ $# -gt 0 ]]; do
     --jobs) jobs="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --bin) bin="$2"; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    --table-only) table_only=1; shift ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "detection_eval: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -90,6 +93,7 @@ runs() {  # scenario seed set, one per line
   for s in $held; do echo "$1 $s held"; done
 }
 for scenario in $scenarios; do
+  ((table_only)) && break
   echo "detection_eval: $scenario (templates are built once, then read from $EPICHEAD_CACHE_DIR)" >&2
   # The first run alone builds the template cache; the others read it, in parallel.
   runs "$scenario" | head -1 | xargs -L 1 bash -c 'one "$0" "$1" "$2"'
@@ -102,6 +106,7 @@ cat "$out"/rows/*.tsv | sort -k1,1 -k2,2n > "$out/rows.tsv"
 awk -F'\t' '
   function med(a, n,   i, j, t) { for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
                                   return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
+  NF < 13 || $9 == "" || $10 == "" { next }  # a run cut short (its row is incomplete)
   { k = $1 " " $3; n[k]++; right[k] += $5 + $7; found_wrong[k] += ($4 && !$5) + ($6 && !$7)
     no[k, n[k]] = $9; if (!(k in mn) || $9 < mn[k]) mn[k] = $9; ok[k] += ($9 >= $10 - 1)
     ms[k, n[k]] = $8; re[k] += $11 }
