@@ -131,8 +131,9 @@ int run_detect(const DetectArgs& a) {
   if (a.every_hypothesis)
     for (std::size_t i = 0; i < result->hypotheses.size(); ++i) {
       const auto& h = result->hypotheses[i];
-      cv::Mat pic = canvas.clone();
-      if (image->channels() == 1) cv::cvtColor(*image, pic, cv::COLOR_GRAY2BGR); else pic = image->clone();
+      cv::Mat pic;
+      if (image->channels() == 1) cv::cvtColor(*image, pic, cv::COLOR_GRAY2BGR);
+      else pic = image->clone();
       OverlayStyle start_style;
       start_style.left = start_style.right = start_style.both = start_style.ellipse = cv::Scalar(160, 160, 160);
       draw_visible_model(pic, compute_visibility(seq->model(), seq->camera(), h.start_cam_T_obj, tracking.visibility), start_style);

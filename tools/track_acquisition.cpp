@@ -57,10 +57,8 @@ bool TrackAcquisition::after_frame(vision::TrackStatus status) {
   return options_.reacquire && lost_run_ >= options_.lost_frames_before_detection;
 }
 
-std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_again(const cv::Mat& frame, int frame_number,
-                                                                                          double t_s,
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_again(const cv::Mat& frame, double t_s,
                                                                                           const Eigen::Isometry3d& predicted) {
-  (void)frame_number;
   auto r = detect(frame, t_s, predicted);
   if (r && *r) {
     ++reacquired_;
@@ -97,7 +95,7 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
                                                                   vision::FrameReport& report) {
   std::optional<Eigen::Isometry3d> found;
   if (after_frame(report.status)) {
-    auto again = find_again(frame, 0, t_s, predicted);
+    auto again = find_again(frame, t_s, predicted);
     if (!again) return std::unexpected(again.error());
     found = *again;
   } else if (report.status != vision::TrackStatus::Lost && recheck_due(t_s)) {

@@ -45,7 +45,7 @@ class TrackAcquisition {
   // frame (lost for lost_frames_before_detection frames in a row, and re-acquisition on).
   bool after_frame(vision::TrackStatus status);
   // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
-  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, int frame_number, double t_s,
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, double t_s,
                                                                           const Eigen::Isometry3d& predicted);
   // After the frame's tracking step (report): detection when the object has been lost for a few
   // frames (near `predicted` first), and the provisional start's recheck. When either finds a
