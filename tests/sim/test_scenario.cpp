@@ -165,6 +165,17 @@ TEST_CASE("built-in motions: walking bursts 30-80 deg/s, box_clutter peaks near 
   }
 }
 
+// The share of the model's vertices in front of the camera and inside the image.
+double share_in_view(const epichead::vision::CadModel& model, const epichead::vision::Camera& cam,
+                     const Eigen::Isometry3d& cam_T_obj) {
+  int inside = 0;
+  for (const auto& v : model.vertices) {
+    const Eigen::Vector3d p = cam_T_obj * v;
+    inside += p.z() > 0.05 && cam.in_image(cam.project(p));
+  }
+  return static_cast<double>(inside) / static_cast<double>(model.vertices.size());
+}
+
 TEST_CASE("the tracked object stays in view in every frame of every built-in scenario but the acquisition ones",
           "[sim][scenario]") {
   for (const auto& name : builtin_scenario_names()) {
@@ -178,13 +189,7 @@ TEST_CASE("the tracked object stays in view in every frame of every built-in sce
     double worst = 1;
     int worst_frame = -1;
     for (int i = 0; i < s.frames; ++i) {
-      const Eigen::Isometry3d cam_T_obj = rig.cam_T_obj(s.frame_time_s(i));
-      int inside = 0;
-      for (const auto& v : model->vertices) {
-        const Eigen::Vector3d p = cam_T_obj * v;
-        inside += p.z() > 0.05 && cam->in_image(cam->project(p));
-      }
-      const double fraction = static_cast<double>(inside) / static_cast<double>(model->vertices.size());
+      const double fraction = share_in_view(*model, *cam, rig.cam_T_obj(s.frame_time_s(i)));
       if (fraction < worst) { worst = fraction; worst_frame = i; }
     }
     INFO(name << ": worst frame " << worst_frame << " has " << 100 * worst << " % of the vertices in the image");
@@ -201,14 +206,7 @@ TEST_CASE("late_entry starts with the package out of view and ends with it in vi
     auto cam = scenario_camera(s);
     REQUIRE(cam);
     const Rig rig = Rig::from_scenario(s, Eigen::Vector3d::Zero());
-    auto in_view = [&](int i) {
-      int inside = 0;
-      for (const auto& v : model->vertices) {
-        const Eigen::Vector3d p = rig.cam_T_obj(s.frame_time_s(i)) * v;
-        inside += p.z() > 0.05 && cam->in_image(cam->project(p));
-      }
-      return static_cast<double>(inside) / static_cast<double>(model->vertices.size());
-    };
+    auto in_view = [&](int i) { return share_in_view(*model, *cam, rig.cam_T_obj(s.frame_time_s(i))); };
     INFO(name);
     CHECK(in_view(s.frames - 1) == 1.0);
     if (name == "late_entry") CHECK(in_view(0) < 0.5);
