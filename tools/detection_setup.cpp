@@ -24,7 +24,7 @@ void add_detection_options(CLI::App& app, DetectionArgs& a) {
   app.add_option("--max-distance-m", a.options.max_distance_m, "Detection: the farthest object distance to search, m")
       ->check(CLI::Range(0.0, 1e3));
   app.add_option("--views", a.options.view_subdivisions,
-                 "Detection: view sphere subdivisions (1: 42 views, 2: 162, 3: 642)")
+                 "Detection: view sphere subdivisions (0: 12 views, 1: 42, 2: 162, 3: 642, 4: 2562)")
       ->check(CLI::Range(0, 4));
   app.add_option("--hypotheses", a.options.max_hypotheses,
                  "Detection: hypotheses refined and verified per search (more: slower, finds more)")

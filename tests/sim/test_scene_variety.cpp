@@ -84,8 +84,11 @@ TEST_CASE("a seed draws the same scene every time, another seed a different one"
 
 TEST_CASE("every drawn scene keeps the object in view in every frame and visible against its background",
           "[sim][scene_variety]") {
+  // Three of the seeds 1-5 per scenario, a different three for the next: every seed is drawn
+  // for several scenarios at three fifths of the time that all five for all would take.
+  std::uint64_t first = 0;
   for (const auto& name : builtin_scenario_names()) {
-    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    for (std::uint64_t seed : {first % 5 + 1, (first + 1) % 5 + 1, (first + 2) % 5 + 1}) {
       CAPTURE(name, seed);
       const ScenarioScene m = made(builtin(name, seed, 1.0));
       auto cam = scenario_camera(m.scenario);
@@ -101,6 +104,7 @@ TEST_CASE("every drawn scene keeps the object in view in every frame and visible
       if (m.drawn.pole) CHECK(m.drawn.pole_diameter_m > 0);
       if (m.scenario.motion == MotionKind::walking) CHECK(m.scenario.walking.burst_s < m.scenario.walking.step_period_s);
     }
+    ++first;
   }
 }
 

@@ -144,7 +144,7 @@ TEST_CASE("circle edge points and junctions recover the pose", "[pose]") {
   }
   problem.ellipses.push_back(rim);
   // A circle leaves the turn about its axis free: two junctions fix it.
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0, 0)})
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0, 0)})
     problem.points.push_back({static_cast<int>(problem.points.size()) + 1, p, kCamera.project(truth * p), 1.0});
   PoseEstimator estimator(kCamera);
   PoseResult result;
