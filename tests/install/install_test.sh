@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Installs a build tree into a fresh prefix and uses it as another project would: a CMake
+# project (find_package(epichead), epichead::<module> targets) and a plain compile with
+# pkg-config, each tracking the first frames of a sequence; then the installed program runs a
+# built-in scenario away from the source tree.
+# Usage: tests/install/install_test.sh BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS]
+#   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+build="$1" work="$2" seq="$3" flags="${4:-}"
+rm -rf "$work"
+mkdir -p "$work"
+prefix="$work/prefix"
+step() { echo "install_test: $*"; }
+
+step "cmake --install $build --prefix $prefix"
+cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+for f in bin/epichead include/epichead/vision/model_tracker.h share/doc/epichead/LICENSE; do
+  [[ -e "$prefix/$f" ]] || { echo "install_test: $prefix/$f was not installed" >&2; exit 1; }
+done
+config=$(find "$prefix" -name epicheadConfig.cmake | head -1)
+pc=$(find "$prefix" -name epichead.pc | head -1)
+[[ -n "$config" && -n "$pc" ]] || { echo "install_test: no epicheadConfig.cmake or epichead.pc under $prefix" >&2; exit 1; }
+
+step "a CMake project: find_package(epichead)"
+cmake -S "$here/consumer" -B "$work/cmake-consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" > "$work/consumer-configure.log"
+cmake --build "$work/cmake-consumer" > "$work/consumer-build.log" 2>&1 || { cat "$work/consumer-build.log" >&2; exit 1; }
+"$work/cmake-consumer/consumer" "$seq" 5
+
+step "a plain compile: pkg-config --cflags --libs epichead"
+export PKG_CONFIG_PATH="$(dirname "$pc")"
+# shellcheck disable=SC2046,SC2086
+# (pkg-config gives OpenCV's headers as -I, not -isystem: their warnings go to the log.)
+g++ -std=c++23 $flags "$here/consumer/consumer.cpp" -o "$work/pc-consumer" $(pkg-config --cflags --libs epichead) \
+  > "$work/pc-build.log" 2>&1 || { cat "$work/pc-build.log" >&2; exit 1; }
+"$work/pc-consumer" "$seq" 5
+version=$(pkg-config --modversion epichead)
+
+step "the installed program, away from the source tree"
+cd "$work"
+program_version=$("$prefix/bin/epichead" --version)
+[[ "$program_version" == *"$version"* ]] ||
+  { echo "install_test: the program says '$program_version', pkg-config '$version'" >&2; exit 1; }
+"$prefix/bin/epichead" sim box_clutter --frames 2 --out "$work/sim" > /dev/null
+[[ -f "$work/sim/frames/000001.png" ]] || { echo "install_test: the installed program simulated no frames" >&2; exit 1; }
+step "ok (version $version)"
