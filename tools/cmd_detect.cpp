@@ -2,14 +2,15 @@
 // from the CAD model and the camera alone (vision/detector.h). Writes DIR/pose.csv (init.csv's
 // format: copy it in as the sequence's init.csv), DIR/detection.json (every hypothesis, the
 // timings, the template cache) and DIR/detection.png (the found pose drawn over the frame).
-// With gt.csv the error of the found pose is printed too. Exit 0 found, 1 not found or an
-// error, 2 a bad command line.
+// With gt.csv the error of the found pose is printed too (not with --model, another model than
+// the sequence's). Exit 0 found, 1 not found or an error, 2 a bad command line.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,7 @@
 
 #include "command.h"
 #include "detection_setup.h"
+#include "epichead/vision/cao_model.h"
 #include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/visibility.h"
@@ -28,7 +30,7 @@ using namespace epichead::vision;
 namespace fs = std::filesystem;
 
 struct DetectArgs {
-  std::string seq, out = "detect_out", imu = "off";
+  std::string seq, out = "detect_out", imu = "off", model;
   int frame = 0;
   bool every_hypothesis = false;
   DetectionArgs detection;
@@ -74,14 +76,24 @@ int run_detect(const DetectArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec) return fail(cmd, "cannot create " + a.out + ": " + ec.message());
 
+  // Another model than the sequence's: what the detector says when the object in view is not
+  // the one it searches for (docs/detection.md, "a wrong object in view").
+  std::optional<CadModel> other_model;
+  if (!a.model.empty()) {
+    auto loaded = load_cao(a.model);
+    if (!loaded) return fail(cmd, loaded.error());
+    other_model = std::move(*loaded);
+  }
+  const CadModel& model = other_model ? *other_model : seq->model();
   const ModelTrackerOptions tracking;
-  auto detector = make_detector(cmd, seq->model(), seq->camera(), a.detection, tracking);
+  auto detector = make_detector(cmd, model, seq->camera(), a.detection, tracking);
   if (!detector) return fail(cmd, detector.error());
   const auto result = (*detector)->detect(*image, prior);
   if (!result) return fail(cmd, result.error());
 
   nlohmann::json j;
   j["sequence"] = a.seq;
+  j["model"] = a.model.empty() ? (fs::path(a.seq) / "model.cao").string() : a.model;
   j["frame"] = entry.frame;
   j["found"] = result->found;
   j["templates"] = (*detector)->template_count();
@@ -102,11 +114,11 @@ int run_detect(const DetectArgs& a) {
     e["similarity"] = h.similarity;
     e["status"] = to_string(h.status);
     e["start"] = pose_json(h.start_cam_T_obj);
-    if (const auto err = error_to_truth(*seq, entry.frame, h.cam_T_obj)) {
+    if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, h.cam_T_obj)) {
       e["rotation_error_deg"] = err->first;
       e["translation_error_mm"] = err->second;
     }
-    if (const auto err = error_to_truth(*seq, entry.frame, h.start_cam_T_obj)) {
+    if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, h.start_cam_T_obj)) {
       e["start_rotation_error_deg"] = err->first;
       e["start_translation_error_mm"] = err->second;
     }
@@ -121,7 +133,7 @@ int run_detect(const DetectArgs& a) {
   cv::Mat canvas = image->channels() == 1 ? cv::Mat() : image->clone();
   if (image->channels() == 1) cv::cvtColor(*image, canvas, cv::COLOR_GRAY2BGR);
   if (!result->hypotheses.empty()) {
-    VisibleModel visible = compute_visibility(seq->model(), seq->camera(), result->best.cam_T_obj, tracking.visibility);
+    VisibleModel visible = compute_visibility(model, seq->camera(), result->best.cam_T_obj, tracking.visibility);
     OverlayStyle style;
     if (!result->found) style.left = style.right = style.both = style.ellipse = cv::Scalar(60, 60, 255);
     style.thickness = 2;
@@ -136,8 +148,8 @@ int run_detect(const DetectArgs& a) {
       else pic = image->clone();
       OverlayStyle start_style;
       start_style.left = start_style.right = start_style.both = start_style.ellipse = cv::Scalar(160, 160, 160);
-      draw_visible_model(pic, compute_visibility(seq->model(), seq->camera(), h.start_cam_T_obj, tracking.visibility), start_style);
-      draw_visible_model(pic, compute_visibility(seq->model(), seq->camera(), h.cam_T_obj, tracking.visibility));
+      draw_visible_model(pic, compute_visibility(model, seq->camera(), h.start_cam_T_obj, tracking.visibility), start_style);
+      draw_visible_model(pic, compute_visibility(model, seq->camera(), h.cam_T_obj, tracking.visibility));
       char text[128];
       std::snprintf(text, sizeof text, "hypothesis %zu  support %.2f  score %.0f  similarity %.0f  %s", i, h.support, h.score,
                     h.similarity, to_string(h.status));
@@ -159,7 +171,7 @@ int run_detect(const DetectArgs& a) {
               entry.frame, result->found ? "found" : "not found", result->best.support, (*detector)->template_count(),
               (*detector)->loaded_from_cache() ? "cached" : "built", (*detector)->build_s(), result->templates_matched,
               result->matches, result->hypotheses.size(), result->match_ms, result->refine_ms);
-  if (const auto err = error_to_truth(*seq, entry.frame, result->best.cam_T_obj))
+  if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, result->best.cam_T_obj))
     std::printf("against gt.csv: %.2f deg, %.1f mm\n", err->first, err->second);
   if (!result->found) return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + " (best support " +
                                            std::to_string(result->best.support) + "); see " + png_path);
@@ -177,6 +189,9 @@ const CommandRegistration registration{
       app.add_option("--frame", a->frame, "Frame index (0-based position in the sequence)");
       app.add_option("--out", a->out, "Output directory: pose.csv, detection.json, detection.png")->capture_default_str();
       app.add_option("--imu", a->imu, "on: gravity from imu.csv narrows the search (needs --object-up)")->capture_default_str();
+      app.add_option("--model", a->model,
+                     "Search for this .cao model instead of the sequence's model.cao (e.g. to check that an object "
+                     "not in view is reported not found)");
       app.add_flag("--every-hypothesis", a->every_hypothesis,
                    "Also write hypothesis_NN.png: each refined hypothesis (colour) over its template's pose (grey)");
       add_detection_options(app, a->detection);

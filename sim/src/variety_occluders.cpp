@@ -78,7 +78,7 @@ void add_pole(Scene& s, Scenario& run, const Rig& rig, const Draws& d, SceneVari
 }
 
 void add_cover(Scene& s, Scenario& run, const Rig& rig, const CoverWindow& w) {
-  constexpr double slide_s = 0.3, depth_m = 0.2, size_m = 0.8, out_m = 0.7, step_s = 1.0 / 120;
+  constexpr double slide_s = CoverWindow::kSlideS, depth_m = 0.2, size_m = 0.8, out_m = 0.7, step_s = 1.0 / 120;
   Material m;
   m.albedo_bgr = {0.33f, 0.47f, 0.58f};  // cardboard
   s.materials.push_back(m);

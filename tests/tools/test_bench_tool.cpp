@@ -76,3 +76,14 @@ TEST_CASE("bench refuses a bad filter and a filter that matches nothing", "[benc
   CHECK(none.exit_code != 0);
   CHECK(none.err.find("no benchmark matches") != std::string::npos);
 }
+
+TEST_CASE("bench --list names every benchmark, the detection ones among them", "[bench]") {
+  TempDir tmp;
+  const ToolRun r = bench(tmp, "--list");
+  REQUIRE(r.exit_code == 0);
+  for (const char* name : {"epic_window", "track_cycle", "imu_step", "detect_640x480", "detect_near", "detect_build_teabox",
+                           "detect_build_300"}) {
+    INFO(name);
+    CHECK(("\n" + r.out).find(std::string("\n") + name + "\n") != std::string::npos);
+  }
+}

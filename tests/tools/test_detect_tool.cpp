@@ -87,7 +87,7 @@ TEST_CASE("detect builds its templates once into the cache, reads them after, an
   CHECK(slurp(cache).size() == saved.size());
 }
 
-TEST_CASE("detect: a frame out of range, a bad --object-up and --imu on without imu.csv are errors naming the problem") {
+TEST_CASE("detect: a frame out of range, a bad --object-up, --imu on without imu.csv and a missing --model are errors naming the problem") {
   TempDir tmp("epichead_test_detect_errors");
   const auto range = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 999 --out " + q(tmp / "o") + kCache);
   CHECK(range.exit_code == 1);
@@ -98,6 +98,9 @@ TEST_CASE("detect: a frame out of range, a bad --object-up and --imu on without 
   const auto imu = run_epichead(tmp, "detect " + q(kTeabox) + " --imu on --out " + q(tmp / "o") + kCache);
   CHECK(imu.exit_code == 1);
   CHECK(imu.err.find("--imu on needs imu.csv") != std::string::npos);
+  const auto model = run_epichead(tmp, "detect " + q(kTeabox) + " --model " + q(tmp / "none.cao") + " --out " + q(tmp / "o") + kCache);
+  CHECK(model.exit_code == 1);
+  CHECK(model.err.find(tmp / "none.cao") != std::string::npos);
 }
 
 TEST_CASE("track without init.csv detects the tea box and follows the real teabox video") {
@@ -122,6 +125,15 @@ TEST_CASE("track finds the package again after a board hides it for a second (bo
   const std::string seq = tmp / "box_cover", out = tmp / "track";
   // 4.5 s: the board slides in at 2.2 s, hides everything from 2.5 s to 3.5 s and is gone at 3.8 s.
   REQUIRE(run_epichead(tmp, "sim box_cover --out " + q(seq) + " --frames 135").exit_code == 0);
+  // The simulator says when the whole package is in view: before the board comes (2.2 s) and
+  // after it has gone (3.8 s); frame i is at 0.2 s + i / 30.
+  const auto in_view = nlohmann::json::parse(slurp(seq + "/sim_truth.json"))["object_in_view_frames"];
+  INFO(in_view.dump());
+  REQUIRE(in_view.size() == 2);
+  CHECK(in_view[0][0] == 0);
+  CHECK(in_view[0][1] == 59);
+  CHECK(in_view[1][0] == 108);
+  CHECK(in_view[1][1] == 134);
   const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video" + kCache);
   INFO(run.out << run.err);
   REQUIRE(run.exit_code == 0);

@@ -1,5 +1,6 @@
 // Topology of a CAD model: face normals and triangulations, edges with their faces, junctions
-// and parallel edge pairs, from vertices and vertex loops (build_model).
+// and parallel edge pairs, from vertices and vertex loops (build_model); the points that stand
+// for its outline (outline_points).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -466,6 +467,18 @@ bool on_circle(const ModelCircle& circle, const Eigen::Vector3d& p_obj) {
   const Eigen::Vector3d d = p_obj - circle.centre_obj;
   const double tol = 1e-3 * circle.radius_m + 1e-6;
   return std::abs(d.dot(n)) <= tol && std::abs((d - d.dot(n) * n).norm() - circle.radius_m) <= tol;
+}
+
+std::vector<Eigen::Vector3d> outline_points(const CadModel& model, std::size_t max_vertices) {
+  std::vector<Eigen::Vector3d> points;
+  const std::size_t step = std::max<std::size_t>(1, model.vertices.size() / std::max<std::size_t>(1, max_vertices));
+  for (std::size_t i = 0; i < model.vertices.size(); i += step) points.push_back(model.vertices[i]);
+  for (const auto& c : model.circles) {
+    const Eigen::Vector3d u = c.normal_obj.unitOrthogonal(), v = c.normal_obj.normalized().cross(u);
+    for (int k = 0; k < 8; ++k)
+      points.push_back(c.centre_obj + c.radius_m * (std::cos(k * std::numbers::pi / 4) * u + std::sin(k * std::numbers::pi / 4) * v));
+  }
+  return points;
 }
 
 }  // namespace epichead::vision

@@ -76,14 +76,7 @@ std::uint64_t Detector::Impl::key() const {
 
 void Detector::Impl::grids() {
   model_extent(*model, centre_obj, radius_m);
-  // At most 64 points: the vertices (every k-th), and eight points on each circle.
-  const std::size_t step = std::max<std::size_t>(1, model->vertices.size() / 64);
-  for (std::size_t i = 0; i < model->vertices.size(); i += step) outline_obj.push_back(model->vertices[i]);
-  for (const auto& c : model->circles) {
-    const Eigen::Vector3d u = c.normal_obj.unitOrthogonal(), v = c.normal_obj.normalized().cross(u);
-    for (int k = 0; k < 8; ++k)
-      outline_obj.push_back(c.centre_obj + c.radius_m * (std::cos(k * M_PI / 4) * u + std::sin(k * M_PI / 4) * v));
-  }
+  outline_obj = outline_points(*model);
   views = detail::view_directions(options.view_subdivisions);
   const int rolls = std::max(1, static_cast<int>(std::lround(360.0 / options.in_plane_step_deg)));
   for (int r = 0; r < rolls; ++r) rolls_rad.push_back(2 * M_PI * r / rolls);

@@ -38,8 +38,11 @@ struct OccluderKey {
 // A window in which a large board slides in front of the camera and hides the tracked object
 // completely (key `cover`): the tracker must notice the loss and recover afterwards.
 struct CoverWindow {
-  double start_s = 0;     // the board starts to slide in
-  double duration_s = 1;  // how long the object is fully hidden
+  static constexpr double kSlideS = 0.3;  // the board slides in before start_s and out after the end
+  double start_s = 0;     // the object is fully hidden from here
+  double duration_s = 1;  // for this long
+  // The board is in front of the camera (sliding or still) at t_s.
+  bool board_in_view(double t_s) const { return t_s >= start_s - kSlideS && t_s <= start_s + duration_s + kSlideS; }
 };
 
 struct Scenario {

@@ -76,6 +76,11 @@ struct CadModel {
   std::vector<std::string> warnings;
 };
 
+// Points whose projections stand for the model's outline: every k-th vertex (at most
+// `max_vertices` of them) and eight points on each circle. A pose puts the whole model in the
+// image when all of them project inside it.
+std::vector<Eigen::Vector3d> outline_points(const CadModel& model, std::size_t max_vertices = 64);
+
 // Parses a CAO file (and the files it load()s, relative to the including file, with a
 // cycle check). Errors say "file:line: what was expected". Never crashes or hangs on garbage.
 std::expected<CadModel, std::string> load_cao(const std::string& path);

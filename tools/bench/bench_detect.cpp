@@ -1,0 +1,138 @@
+// Detection benchmarks (vision/detector.h), on a simulated 640x480 frame of the printed package
+// on its cluttered table (box_clutter, frame 0):
+//   detect_640x480       one global search with the default options, templates cached (built
+//                        on the first run into the default cache, ~/.cache/epichead)
+//   detect_near          re-acquisition's first try: the predicted pose refined and verified
+//                        (here the true pose of the frame)
+//   detect_build_teabox  building templates for the tea box (12 views, 30 deg turns: an
+//   detect_build_300     iteration of the default 162 views and 15 deg turns would take tens of
+//                        seconds), and for a model of 300 edges; per template in ns_per_item:
+//                        the default options build 27x as many (162 views / 12, 24 turns / 12)
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include "bench/bench.h"
+#include "epichead/sim/scenario.h"
+#include "epichead/sim/sequence_writer.h"
+#include "epichead/vision/detector.h"
+#include "epichead/vision/look_at.h"
+#include "epichead/vision/offline/sequence.h"
+
+namespace epichead::bench {
+namespace {
+
+struct DetectBench {
+  std::unique_ptr<vision::Sequence> seq;
+  cv::Mat frame;
+  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+  std::unique_ptr<vision::Detector> detector;
+  vision::DetectionResult result;
+  vision::DetectionHypothesis verified;
+};
+
+// box_clutter's first frame and its model, with the detector's templates (from the cache).
+std::shared_ptr<DetectBench> box_clutter_frame() {
+  auto scenario = sim::find_scenario("box_clutter");
+  if (!scenario) throw std::runtime_error(scenario.error());
+  scenario->frames = 1;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("epichead-bench-detect-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  if (auto written = sim::write_sequence(*scenario, dir.string()); !written) throw std::runtime_error(written.error());
+  auto seq = vision::Sequence::open(dir.string());
+  if (!seq) throw std::runtime_error(seq.error());
+  auto b = std::make_shared<DetectBench>();
+  b->seq = std::make_unique<vision::Sequence>(std::move(*seq));
+  auto frame = b->seq->read_frame(0);
+  if (!frame) throw std::runtime_error(frame.error());
+  b->frame = *frame;
+  b->truth = b->seq->ground_truth().front().cam_T_obj;
+  std::filesystem::remove_all(dir);
+  auto detector = vision::Detector::create(b->seq->model(), b->seq->camera(), {}, {}, vision::default_template_cache_dir());
+  if (!detector) throw std::runtime_error(detector.error());
+  b->detector = std::move(*detector);
+  return b;
+}
+
+const Registration detect_global{"detect_640x480", [] {
+  auto b = box_clutter_frame();
+  return [b] {
+    auto r = b->detector->detect(b->frame);
+    if (r) b->result = std::move(*r);
+  };
+}};
+
+const Registration detect_near{"detect_near", [] {
+  auto b = box_clutter_frame();
+  vision::DetectionPrior prior;
+  prior.near_cam_T_obj = b->truth;
+  return [b, prior] {
+    auto r = b->detector->detect(b->frame, prior);
+    if (r) b->result = std::move(*r);
+  };
+}};
+
+// Axis-aligned box as closed faces (8 vertices, 6 faces CCW from outside).
+void add_box(vision::RawModel& raw, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const int b = static_cast<int>(raw.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    raw.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) raw.face_loops.push_back({b + f[0], b + f[1], b + f[2], b + f[3]});
+}
+
+struct BuildBench {
+  vision::CadModel model;
+  vision::Camera camera{640, 480, {600, 600, 320, 240}};
+  int templates = 0;
+};
+
+// Builds every template of the model (no cache) on the 12-view sphere with 30 deg turns, per
+// iteration. The
+// registration's item count is the number of templates (views of the model that fit in the
+// image): checked here, so that ns_per_item is per template.
+Iteration build_templates(std::shared_ptr<BuildBench> b, const char* name, int templates) {
+  vision::DetectorOptions options;
+  options.view_subdivisions = 0;
+  options.in_plane_step_deg = 30;
+  auto once = vision::Detector::create(b->model, b->camera, options, {}, "");
+  if (!once) throw std::runtime_error(once.error());
+  if ((*once)->template_count() != templates)
+    throw std::runtime_error(std::string(name) + ": " + std::to_string((*once)->template_count()) +
+                             " templates, but its registration counts " + std::to_string(templates));
+  return [b, options] {
+    auto detector = vision::Detector::create(b->model, b->camera, options, {}, "");
+    if (!detector) throw std::runtime_error(detector.error());
+    b->templates = (*detector)->template_count();
+  };
+}
+
+constexpr int kTeaboxTemplates = 976, kGridTemplates = 982;
+
+// The tea box of ../shared/data/teabox (0.165 x 0.068 x 0.08 m) with its camera.
+const Registration build_teabox{"detect_build_teabox", [] {
+  auto b = std::make_shared<BuildBench>();
+  vision::RawModel raw;
+  add_box(raw, {0, 0, -0.08}, {0.165, 0.068, 0});
+  b->model = *vision::build_model(raw, "teabox");
+  b->camera = vision::Camera(640, 480, {839.2147, 839.44555, 325.66776, 243.69727});
+  return build_templates(b, "detect_build_teabox", kTeaboxTemplates);
+}, kTeaboxTemplates};
+
+// 25 boxes on a 5 x 5 grid: 300 edges, 150 faces.
+const Registration build_300{"detect_build_300", [] {
+  auto b = std::make_shared<BuildBench>();
+  vision::RawModel raw;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      add_box(raw, {0.12 * i, 0.12 * j, 0}, {0.12 * i + 0.08, 0.12 * j + 0.08, 0.05 + 0.02 * ((i + j) % 3)});
+  b->model = *vision::build_model(raw, "grid300");
+  return build_templates(b, "detect_build_300", kGridTemplates);
+}, kGridTemplates};
+
+}  // namespace
+}  // namespace epichead::bench
