@@ -8,20 +8,14 @@
 //   detect_build_300     iteration of the default 162 views and 15 deg turns would take tens of
 //                        seconds), and for a model of 300 edges; per template in ns_per_item:
 //                        the default options build 27x as many (162 views / 12, 24 turns / 12)
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <stdexcept>
 
-#include <unistd.h>
-
 #include "bench/bench.h"
 #include "bench/box_models.h"
-#include "epichead/sim/scenario.h"
-#include "epichead/sim/sequence_writer.h"
+#include "bench/simulated_sequence.h"
 #include "epichead/vision/detector.h"
-#include "epichead/vision/look_at.h"
-#include "epichead/vision/offline/sequence.h"
 
 namespace epichead::bench {
 namespace {
@@ -32,27 +26,15 @@ struct DetectBench {
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
   std::unique_ptr<vision::Detector> detector;
   vision::DetectionResult result;
-  vision::DetectionHypothesis verified;
 };
 
 // box_clutter's first frame and its model, with the detector's templates (from the cache).
 std::shared_ptr<DetectBench> box_clutter_frame() {
-  auto scenario = sim::find_scenario("box_clutter");
-  if (!scenario) throw std::runtime_error(scenario.error());
-  scenario->frames = 1;
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("epichead-bench-detect-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  if (auto written = sim::write_sequence(*scenario, dir.string()); !written) throw std::runtime_error(written.error());
-  auto seq = vision::Sequence::open(dir.string());
-  if (!seq) throw std::runtime_error(seq.error());
+  SimulatedSequence sim = simulate_builtin("box_clutter", 1);
   auto b = std::make_shared<DetectBench>();
-  b->seq = std::make_unique<vision::Sequence>(std::move(*seq));
-  auto frame = b->seq->read_frame(0);
-  if (!frame) throw std::runtime_error(frame.error());
-  b->frame = *frame;
+  b->seq = std::move(sim.seq);
+  b->frame = sim.frames.front();
   b->truth = b->seq->ground_truth().front().cam_T_obj;
-  std::filesystem::remove_all(dir);
   auto detector = vision::Detector::create(b->seq->model(), b->seq->camera(), {}, {}, vision::default_template_cache_dir());
   if (!detector) throw std::runtime_error(detector.error());
   b->detector = std::move(*detector);
@@ -84,9 +66,8 @@ struct BuildBench {
 };
 
 // Builds every template of the model (no cache) on the 12-view sphere with 30 deg turns, per
-// iteration. The
-// registration's item count is the number of templates (views of the model that fit in the
-// image): checked here, so that ns_per_item is per template.
+// iteration. The registration's item count is the number of templates (views of the model that
+// fit in the image): checked here, so that ns_per_item is per template.
 Iteration build_templates(std::shared_ptr<BuildBench> b, const char* name, int templates) {
   vision::DetectorOptions options;
   options.view_subdivisions = 0;
@@ -105,24 +86,17 @@ Iteration build_templates(std::shared_ptr<BuildBench> b, const char* name, int t
 
 constexpr int kTeaboxTemplates = 976, kGridTemplates = 982;
 
-// The tea box of ../shared/data/teabox (0.165 x 0.068 x 0.08 m) with its camera.
+// The tea box with its camera.
 const Registration build_teabox{"detect_build_teabox", [] {
   auto b = std::make_shared<BuildBench>();
-  vision::RawModel raw;
-  add_box(raw, {0, 0, -0.08}, {0.165, 0.068, 0});
-  b->model = *vision::build_model(raw, "teabox");
+  b->model = teabox_model();
   b->camera = vision::Camera(640, 480, {839.2147, 839.44555, 325.66776, 243.69727});
   return build_templates(b, "detect_build_teabox", kTeaboxTemplates);
 }, kTeaboxTemplates};
 
-// 25 boxes on a 5 x 5 grid: 300 edges, 150 faces.
 const Registration build_300{"detect_build_300", [] {
   auto b = std::make_shared<BuildBench>();
-  vision::RawModel raw;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j)
-      add_box(raw, {0.12 * i, 0.12 * j, 0}, {0.12 * i + 0.08, 0.12 * j + 0.08, 0.05 + 0.02 * ((i + j) % 3)});
-  b->model = *vision::build_model(raw, "grid300");
+  b->model = box_grid_300_model();
   return build_templates(b, "detect_build_300", kGridTemplates);
 }, kGridTemplates};
 

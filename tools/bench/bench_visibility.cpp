@@ -10,7 +10,6 @@
 namespace {
 
 using namespace epichead::vision;
-using epichead::bench::add_box;
 
 
 
@@ -25,9 +24,7 @@ struct VisibilityBench {
 // The teabox of ../shared/data/teabox (0.165 x 0.068 x 0.08 m) at its frame-0 pose.
 const epichead::bench::Registration teabox{"visibility_teabox", [] {
   auto b = std::make_shared<VisibilityBench>();
-  RawModel raw;
-  add_box(raw, {0, 0, -0.08}, {0.165, 0.068, 0});
-  b->model = *build_model(raw, "teabox");
+  b->model = epichead::bench::teabox_model();
   b->camera = Camera(640, 480, {839.2147, 839.44555, 325.66776, 243.69727});
   b->pose = Eigen::Isometry3d::Identity();
   b->pose.linear() = Eigen::Quaterniond(0.479187837, 0.712274104, 0.452593677, -0.241254183).normalized().toRotationMatrix();
@@ -39,11 +36,7 @@ const epichead::bench::Registration teabox{"visibility_teabox", [] {
 // 25 boxes on a 5 x 5 grid (300 edges, 150 faces), seen obliquely so that they hide each other.
 const epichead::bench::Registration grid300{"visibility_300", [] {
   auto b = std::make_shared<VisibilityBench>();
-  RawModel raw;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j)
-      add_box(raw, {0.12 * i, 0.12 * j, 0}, {0.12 * i + 0.08, 0.12 * j + 0.08, 0.05 + 0.02 * ((i + j) % 3)});
-  b->model = *build_model(raw, "grid300");
+  b->model = epichead::bench::box_grid_300_model();
   b->pose = look_at({-0.5, -0.4, 0.45}, {0.26, 0.26, 0.03}).inverse();
   b->visibility = std::make_unique<Visibility>(b->model, b->camera);
   return [b] { b->visibility->compute(b->pose, b->out); };
