@@ -85,6 +85,10 @@ int run_detect(const DetectArgs& a) {
     other_model = std::move(*loaded);
   }
   const CadModel& model = other_model ? *other_model : seq->model();
+  // gt.csv is the truth of the sequence's model only.
+  const auto truth_error = [&](const Eigen::Isometry3d& T) {
+    return other_model ? std::nullopt : error_to_truth(*seq, entry.frame, T);
+  };
   const ModelTrackerOptions tracking;
   auto detector = make_detector(cmd, model, seq->camera(), a.detection, tracking);
   if (!detector) return fail(cmd, detector.error());
@@ -114,11 +118,11 @@ int run_detect(const DetectArgs& a) {
     e["similarity"] = h.similarity;
     e["status"] = to_string(h.status);
     e["start"] = pose_json(h.start_cam_T_obj);
-    if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, h.cam_T_obj)) {
+    if (const auto err = truth_error(h.cam_T_obj)) {
       e["rotation_error_deg"] = err->first;
       e["translation_error_mm"] = err->second;
     }
-    if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, h.start_cam_T_obj)) {
+    if (const auto err = truth_error(h.start_cam_T_obj)) {
       e["start_rotation_error_deg"] = err->first;
       e["start_translation_error_mm"] = err->second;
     }
@@ -171,7 +175,7 @@ int run_detect(const DetectArgs& a) {
               entry.frame, result->found ? "found" : "not found", result->best.support, (*detector)->template_count(),
               (*detector)->loaded_from_cache() ? "cached" : "built", (*detector)->build_s(), result->templates_matched,
               result->matches, result->hypotheses.size(), result->match_ms, result->refine_ms);
-  if (const auto err = other_model ? std::nullopt : error_to_truth(*seq, entry.frame, result->best.cam_T_obj))
+  if (const auto err = truth_error(result->best.cam_T_obj))
     std::printf("against gt.csv: %.2f deg, %.1f mm\n", err->first, err->second);
   if (!result->found) return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + " (best support " +
                                            std::to_string(result->best.support) + "); see " + png_path);
