@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <expected>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -17,7 +18,7 @@
 #include <vector>
 
 #include "command.h"
-#include "epichead/vision/offline/model_symmetry.h"
+#include "epichead/vision/model_symmetry.h"
 #include "line_selection_score.h"
 #include "epichead/vision/offline/score.h"
 #include "epichead/vision/offline/sequence.h"
@@ -92,6 +93,29 @@ void print_human(const std::string& seq_dir, const ScoreSummary& s, int ignored)
   row("reprojection_px", s.reprojection_px);
 }
 
+// The frames a simulated sequence's cover board hides the whole object in (sim_truth.json's
+// object_hidden_frames, runs [first, last]); empty for a sequence without that file or key.
+std::expected<std::set<int>, std::string> hidden_frames(const std::string& seq_dir) {
+  const std::string path = seq_dir + "/sim_truth.json";
+  std::ifstream in(path);
+  std::set<int> hidden;
+  if (!in) return hidden;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    if (!j.contains("object_hidden_frames")) return hidden;
+    for (const auto& run : j.at("object_hidden_frames")) {
+      const int first = run.at(0).get<int>(), last = run.at(1).get<int>();
+      if (first < 0 || last < first || last - first > 10'000'000)
+        return std::unexpected(path + ": object_hidden_frames holds a bad run [" + std::to_string(first) + ", " +
+                               std::to_string(last) + "]");
+      for (int f = first; f <= last; ++f) hidden.insert(f);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return std::unexpected(path + ": " + e.what());
+  }
+  return hidden;
+}
+
 // --corners FRAME:FILE...: per frame, the distance of the projected model points from the
 // hand-read corners at that frame's estimate (present: false when lost or absent).
 std::expected<nlohmann::json, std::string> score_corners(const std::vector<std::string>& specs,
@@ -137,6 +161,7 @@ const CommandRegistration registration{
       auto corners = std::make_shared<std::vector<std::string>>();
       auto lines = std::make_shared<std::string>();
       auto symmetric = std::make_shared<bool>(false);
+      auto include_hidden = std::make_shared<bool>(false);
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
@@ -145,6 +170,9 @@ const CommandRegistration registration{
       app.add_option("--sym-axis", *axis_text,
                      "X,Y,Z: the object is symmetric about this axis through its origin (object frame); "
                      "the unobservable turn about it is removed before scoring");
+      app.add_flag("--include-hidden", *include_hidden,
+                   "Also score the frames in which a cover board hides the whole object (sim_truth.json's "
+                   "object_hidden_frames); by default they are left out, since nothing can be measured there");
       app.add_flag("--symmetric", *symmetric,
                    "Score up to the model's own symmetries (turns that map its points onto its points, e.g. a box's half "
                    "turns): a pose found without a start (detect) may be any of them");
@@ -195,6 +223,18 @@ const CommandRegistration registration{
           return 0;
         }
 
+        // Frames a cover board hides the object in are not scored (nothing can be measured
+        // there), unless --include-hidden; an estimate that claims to track one is counted.
+        std::set<int> hidden;
+        int hidden_tracked = 0;
+        if (reference->empty() && !*include_hidden) {
+          auto read = hidden_frames(*seq_dir);
+          if (!read) return fail("score", read.error());
+          hidden = std::move(*read);
+          std::erase_if(truth_poses, [&](const vision::StampedPose& g) { return hidden.count(g.frame) > 0; });
+          for (const auto& e : *estimates) hidden_tracked += hidden.count(e.frame) > 0 && e.status == "tracked";
+        }
+        const int hidden_count = static_cast<int>(hidden.size());
         const std::vector<Eigen::Isometry3d> symmetries =
             *symmetric ? vision::model_symmetries(seq->model()) : std::vector<Eigen::Isometry3d>{};
         const ScoreSummary summary =
@@ -208,7 +248,7 @@ const CommandRegistration registration{
         std::set<int> truth_frames;
         for (const auto& g : truth_poses) truth_frames.insert(g.frame);
         int ignored = 0;
-        for (const auto& e : *estimates) ignored += truth_frames.count(e.frame) == 0;
+        for (const auto& e : *estimates) ignored += truth_frames.count(e.frame) == 0 && hidden.count(e.frame) == 0;
 
         if (!per_frame->empty()) {
           if (auto written = write_per_frame(*per_frame, summary); !written) return fail("score", written.error());
@@ -222,6 +262,8 @@ const CommandRegistration registration{
                                  {"success_rate_2cm_2deg", summary.success_rate_tight},
                                  {"losses", summary.losses},
                                  {"ignored", ignored},
+                                 {"hidden_frames", hidden_count},
+                                 {"hidden_reported_tracked", hidden_tracked},
                                  {"rotation_deg", stats_json(summary.rotation_deg)},
                                  {"translation_mm", stats_json(summary.translation_mm)},
                                  {"reprojection_px", stats_json(summary.reprojection_px)},
@@ -231,6 +273,9 @@ const CommandRegistration registration{
           std::cout << j.dump() << std::endl;
         } else {
           print_human(*seq_dir, summary, ignored);
+          if (hidden_count > 0)
+            std::printf("hidden           %d frames with the object behind a cover, not scored (%d reported tracked)\n",
+                        hidden_count, hidden_tracked);
           for (const auto& c : *corner_json)
             if (c["present"].get<bool>())
               std::printf("corners frame %d   %.2f px rms, %.2f px max\n", c["frame"].get<int>(), c["rms_px"].get<double>(),

@@ -34,7 +34,7 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
-#include "epichead/vision/offline/model_symmetry.h"
+#include "epichead/vision/model_symmetry.h"
 #include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/visibility.h"
 

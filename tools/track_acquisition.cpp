@@ -12,7 +12,8 @@ TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::Mo
 }
 
 std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::detect(
-    const cv::Mat& frame, double t_s, const std::optional<Eigen::Isometry3d>& near) {
+    const cv::Mat& frame, double t_s, const std::optional<Eigen::Isometry3d>& near,
+    const std::optional<Eigen::Isometry3d>& orient_like) {
   if (!detector_) {
     auto d = make_detector("track", seq_->model(), seq_->camera(), options_.detection, tracking_);
     if (!d) return std::unexpected(d.error());
@@ -20,6 +21,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
   }
   vision::DetectionPrior prior;
   prior.near_cam_T_obj = near;
+  prior.orient_like = orient_like;
   if (options_.use_imu_gravity && up_obj_) {
     prior.up_obj = up_obj_;
     prior.up_cam = up_from_imu(seq_->imu(), t_s);
@@ -78,7 +80,8 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
                                                                                        const Eigen::Isometry3d& tracked) {
   next_recheck_s_ = t_s + options_.recheck_interval_s;
   ++rechecks_;
-  auto found = detect(frame, t_s, std::nullopt);
+  // The whole search; of the poses that draw the same outline, the one turned as the tracked pose is.
+  auto found = detect(frame, t_s, std::nullopt, tracked);
   if (!found) return found;
   const auto now = detector_->verify(frame, tracked);
   if (!now) return std::unexpected(now.error());

@@ -66,7 +66,8 @@ class TrackAcquisition {
     next_recheck_s_ = t_s + options_.recheck_interval_s;
   }
   std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
-                                                                      const std::optional<Eigen::Isometry3d>& near);
+                                                                      const std::optional<Eigen::Isometry3d>& near,
+                                                                      const std::optional<Eigen::Isometry3d>& orient_like = {});
   const vision::Sequence* seq_;
   vision::ModelTrackerOptions tracking_;
   AcquisitionOptions options_;

@@ -30,7 +30,7 @@ vision::Camera downscaled(const vision::Camera& c, int factor) {
   k.fy_px /= f;
   k.cx_px = (k.cx_px + 0.5) / f - 0.5;
   k.cy_px = (k.cy_px + 0.5) / f - 0.5;
-  return vision::Camera(c.width_px() / factor, c.height_px() / factor, k, c.distortion());
+  return vision::Camera(c.width_px() / factor, c.height_px() / factor, k, c.distortion(), c.lens());
 }
 
 std::expected<void, std::string> check(const SimWorldOptions& o, const HeadDynamics& h) {

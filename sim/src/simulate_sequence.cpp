@@ -57,31 +57,55 @@ std::expected<void, std::string> write_text(const fs::path& path, const std::str
   return {};
 }
 
-// The runs of frames [first, last] in which the whole model lies inside the image and no cover
-// board is in front of the camera: where a tracker can see all of the object (an acquisition
-// evaluation counts frames to re-acquire from the start of each run).
-std::vector<std::pair<int, int>> object_in_view_runs(const Scenario& s, const std::vector<vision::StampedPose>& gt,
-                                                     const vision::CadModel& model, const vision::Camera& camera) {
-  const std::vector<Eigen::Vector3d> outline = vision::outline_points(model);
-  std::vector<std::pair<int, int>> runs;
+using FrameRuns = std::vector<std::pair<int, int>>;
+
+// The runs of frames [first, last] of gt for which `keep` holds.
+template <typename Keep>
+FrameRuns frame_runs(const std::vector<vision::StampedPose>& gt, Keep keep) {
+  FrameRuns runs;
   for (const auto& g : gt) {
-    const bool covered = std::any_of(s.covers.begin(), s.covers.end(), [&](const CoverWindow& w) { return w.board_in_view(g.t_s); });
-    const bool whole = std::all_of(outline.begin(), outline.end(), [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d q = g.cam_T_obj * p;
-      return q.z() > 1e-6 && camera.in_image(camera.project(q));
-    });
-    if (covered || !whole) continue;
+    if (!keep(g)) continue;
     if (!runs.empty() && runs.back().second == g.frame - 1) runs.back().second = g.frame;
     else runs.push_back({g.frame, g.frame});
   }
   return runs;
 }
 
+// The runs of frames in which the whole model lies inside the image and no cover board is in
+// front of the camera: where a tracker can see all of the object (an acquisition evaluation
+// counts frames to re-acquire from the start of each run).
+FrameRuns object_in_view_runs(const Scenario& s, const std::vector<vision::StampedPose>& gt, const vision::CadModel& model,
+                              const vision::Camera& camera) {
+  const std::vector<Eigen::Vector3d> outline = vision::outline_points(model);
+  return frame_runs(gt, [&](const vision::StampedPose& g) {
+    const bool covered = std::any_of(s.covers.begin(), s.covers.end(), [&](const CoverWindow& w) { return w.board_in_view(g.t_s); });
+    return !covered && std::all_of(outline.begin(), outline.end(), [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d q = g.cam_T_obj * p;
+      return q.z() > 1e-6 && camera.in_image(camera.project(q));
+    });
+  });
+}
+
+// The runs of frames in which a cover board hides the whole object: no tracker can measure it
+// there, so scoring leaves them out (a frame still being covered or uncovered counts).
+FrameRuns object_hidden_runs(const Scenario& s, const std::vector<vision::StampedPose>& gt) {
+  return frame_runs(gt, [&](const vision::StampedPose& g) {
+    return std::any_of(s.covers.begin(), s.covers.end(), [&](const CoverWindow& w) { return w.hides_object(g.t_s); });
+  });
+}
+
+std::string runs_json(const FrameRuns& runs) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    out += (i ? ", [" : "[") + std::to_string(runs[i].first) + ", " + std::to_string(runs[i].second) + "]";
+  return out + "]";
+}
+
 // sim_truth.json: how the sequence was made (timing, the head's start angles, the IMU's drawn
 // errors, the scene variety, the frames with the whole object in view).
 std::string truth_json(const Scenario& s, double exposure_s, int subframes, const SimSummary& summary,
                        const HeadAngles& head0, const ImuRun& imu, const SceneVariety& drawn,
-                       const std::vector<std::pair<int, int>>& in_view) {
+                       const FrameRuns& in_view, const FrameRuns& hidden) {
   std::ostringstream j;
   j << "{\n  \"scenario\": \"" << s.name << "\",\n  \"scene\": \"" << s.scene << "\",\n  \"seed\": " << s.seed
     << ",\n  \"frames\": " << s.frames << ",\n  \"fps\": " << num(s.fps) << ",\n  \"first_frame_s\": "
@@ -95,9 +119,8 @@ std::string truth_json(const Scenario& s, double exposure_s, int subframes, cons
     << ",\n    \"gyro_scale\": " << vec(imu.gyro_scale) << ",\n    \"accel_scale\": " << vec(imu.accel_scale)
     << ",\n    \"gyro_bias0_radps\": " << vec(imu.gyro_bias0_radps) << ",\n    \"accel_bias0_mps2\": "
     << vec(imu.accel_bias0_mps2) << "\n  }";
-  j << ",\n  \"object_in_view_frames\": [";
-  for (std::size_t i = 0; i < in_view.size(); ++i) j << (i ? ", " : "") << "[" << in_view[i].first << ", " << in_view[i].second << "]";
-  j << "]";
+  j << ",\n  \"object_in_view_frames\": " << runs_json(in_view);
+  j << ",\n  \"object_hidden_frames\": " << runs_json(hidden);
   // Only with variety or covers, so that a built-in scene's output stays as it always was.
   if (s.variety > 0 || !s.covers.empty()) j << ",\n  \"scene_variety\": " << to_json(drawn, "  ");
   j << "\n}\n";
@@ -179,7 +202,8 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, 
 
   const HeadAngles head0 = rig.head_angles(s.frame_time_s(0));
   const std::string sim_truth =
-      truth_json(s, exposure_s, subframes, summary, head0, imu, made->drawn, object_in_view_runs(s, gt, scene->model, *camera));
+      truth_json(s, exposure_s, subframes, summary, head0, imu, made->drawn,
+                 object_in_view_runs(s, gt, scene->model, *camera), object_hidden_runs(s, gt));
   if (auto ok = write_text(dir / "sim_truth.json", sim_truth); !ok) return std::unexpected(ok.error());
   if (auto ok = write_text(dir / "scenario.scn", s.text); !ok) return std::unexpected(ok.error());
 

@@ -237,3 +237,47 @@ TEST_CASE("score --lines counts a selection right on the true edge and wrong whe
   CHECK(bad.exit_code != 0);
   CHECK(bad.err.find("bad.csv") != std::string::npos);
 }
+
+TEST_CASE("score leaves out the frames a cover hides the object in (sim_truth.json), unless --include-hidden, and refuses a bad run naming the file") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  const std::string poses = make_estimates(tmp);  // frame 2 has no estimate
+  {
+    std::ofstream truth(seq + "/sim_truth.json");
+    truth << R"({"scenario": "test", "object_hidden_frames": [[2, 2]]})";
+  }
+  const Run r = score(tmp, q(seq) + " " + q(poses) + " --json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j.at("hidden_frames") == 1);
+  CHECK(j.at("hidden_reported_tracked") == 0);
+  CHECK(j.at("frames") == kFrames - 1);
+  CHECK(j.at("success_rate").get<double>() == Approx(1.0));
+  CHECK(j.at("losses") == 0);
+  CHECK(j.at("ignored") == 0);
+
+  const Run all = score(tmp, q(seq) + " " + q(poses) + " --json --include-hidden");
+  REQUIRE(all.exit_code == 0);
+  const auto k = nlohmann::json::parse(all.out);
+  CHECK(k.at("hidden_frames") == 0);
+  CHECK(k.at("frames") == kFrames);
+  CHECK(k.at("success_rate").get<double>() == Approx(0.8));
+
+  // An estimate that claims to track a hidden frame is counted.
+  {
+    std::ofstream truth(seq + "/sim_truth.json");
+    truth << R"({"object_hidden_frames": [[3, 4]]})";
+  }
+  const Run claimed = score(tmp, q(seq) + " " + q(poses) + " --json");
+  REQUIRE(claimed.exit_code == 0);
+  CHECK(nlohmann::json::parse(claimed.out).at("hidden_reported_tracked") == 2);
+
+  for (const char* bad : {R"({"object_hidden_frames": [[4, 2]]})", R"({"object_hidden_frames": [["a", 2]]})", "{\"object_hidden"}) {
+    std::ofstream(seq + "/sim_truth.json") << bad;
+    const Run e = score(tmp, q(seq) + " " + q(poses) + " --json");
+    INFO(bad << " -> " << e.err);
+    CHECK(e.exit_code != 0);
+    CHECK(e.err.find("sim_truth.json") != std::string::npos);
+  }
+}

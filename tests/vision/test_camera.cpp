@@ -287,3 +287,85 @@ TEST_CASE("camera YAML errors name the file and the field") {
                Catch::Contains("camera.yaml: distortion_coefficients has a non-finite value"));
   }
 }
+
+namespace {
+
+// A wide fisheye lens of the kind cv::fisheye::calibrate is used for (about 180 deg across the
+// diagonal of a 640x480 image).
+Camera fisheye_camera() {
+  return Camera(640, 480, Intrinsics{210.0, 212.0, 318.5, 241.25}, Distortion{0.08, -0.03, 0.01, -0.002, 0.0},
+                epichead::vision::LensModel::Fisheye);
+}
+
+}  // namespace
+
+TEST_CASE("the fisheye model projects as cv::fisheye::projectPoints, out to rays 85 deg off the axis") {
+  const Camera cam = fisheye_camera();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> off_axis(0.0, 85.0 * M_PI / 180.0), around(-M_PI, M_PI), dist(0.3, 4.0);
+  std::vector<cv::Point3d> points;
+  for (int i = 0; i < 500; ++i) {
+    const double a = off_axis(rng), b = around(rng), r = dist(rng);
+    points.emplace_back(r * std::sin(a) * std::cos(b), r * std::sin(a) * std::sin(b), r * std::cos(a));
+  }
+  points.emplace_back(0.0, 0.0, 1.0);  // on the axis: the model's 0/0
+  const auto& k = cam.intrinsics();
+  const cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
+  const auto& d = cam.distortion();
+  const cv::Vec4d D(d[0], d[1], d[2], d[3]);
+  std::vector<cv::Point2d> expected;
+  cv::fisheye::projectPoints(points, expected, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D);
+  double worst = 0, inverse = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p(points[i].x, points[i].y, points[i].z);
+    const Eigen::Vector2d px = cam.project(p);
+    worst = std::max(worst, (px - Eigen::Vector2d(expected[i].x, expected[i].y)).norm());
+    inverse = std::max(inverse, (cam.unproject(px) - p / p.z()).norm() / (p / p.z()).norm() * (p.z() > 0));
+  }
+  CHECK(worst < 1e-6);  // the issue asks for 0.01 px
+  CHECK(inverse < 1e-9);
+}
+
+TEST_CASE("the fisheye model's Jacobian matches finite differences, on the axis too") {
+  const Camera cam = fisheye_camera();
+  for (const Eigen::Vector2d xn : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1e-9, -2e-9), Eigen::Vector2d(0.3, -0.2),
+                                   Eigen::Vector2d(-2.5, 4.0)}) {
+    const Eigen::Matrix2d J = cam.normalized_to_pixel_jacobian(xn);
+    constexpr double h = 1e-6;
+    for (int c = 0; c < 2; ++c) {
+      const Eigen::Vector2d e = Eigen::Vector2d::Unit(c) * h;
+      const Eigen::Vector2d numeric = (cam.normalized_to_pixel(xn + e) - cam.normalized_to_pixel(xn - e)) / (2 * h);
+      INFO("at " << xn.transpose() << " column " << c);
+      CHECK((J.col(c) - numeric).norm() < 1e-4 * std::max(1.0, numeric.norm()));
+    }
+  }
+}
+
+TEST_CASE("a calibration cv::fisheye wrote loads as the fisheye model and saves back the same") {
+  TempDir dir;
+  const Camera written = fisheye_camera();
+  const std::string path = (dir.path / "fisheye.yaml").string();
+  {
+    // As OpenCV's own calibration samples write a cv::fisheye result.
+    cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
+    const auto& k = written.intrinsics();
+    const auto& d = written.distortion();
+    fs << "image_width" << 640 << "image_height" << 480 << "fisheye_model" << 1;
+    fs << "camera_matrix" << (cv::Mat_<double>(3, 3) << k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
+    fs << "distortion_coefficients" << (cv::Mat_<double>(4, 1) << d[0], d[1], d[2], d[3]);
+  }
+  auto cam = Camera::load(path);
+  REQUIRE(cam);
+  CHECK(cam->lens() == epichead::vision::LensModel::Fisheye);
+  CHECK(cam->has_distortion());
+  const Eigen::Vector3d p(0.9, -0.4, 0.6);
+  CHECK((cam->project(p) - written.project(p)).norm() == 0.0);
+
+  const std::string again = (dir.path / "again.yaml").string();
+  REQUIRE(cam->save(again));
+  auto reread = Camera::load(again);
+  REQUIRE(reread);
+  CHECK(reread->lens() == epichead::vision::LensModel::Fisheye);
+  CHECK(reread->distortion() == written.distortion());
+  CHECK((reread->project(p) - written.project(p)).norm() == 0.0);
+}

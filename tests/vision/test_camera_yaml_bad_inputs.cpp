@@ -86,9 +86,12 @@ TEST_CASE("Binary data and text OpenCV cannot parse are errors with the file nam
 }
 
 TEST_CASE("A calibration model the reader does not support is an error, never read as another") {
-  // What cv::fisheye calibration writes: 4 coefficients that are not k1 k2 p1 p2.
+  // A fisheye calibration has k1..k4: five coefficients, or a fisheye_model that is not 0 or 1,
+  // is not one that cv::fisheye wrote.
   CHECK_THAT(load_error(edited("image_width: 160", "fisheye_model: 1\nimage_width: 160")),
-             Catch::Contains("fisheye calibration (fisheye_model) is not supported"));
+             Catch::Contains("must have 4 distortion_coefficients (k1..k4), got 5"));
+  CHECK_THAT(load_error(edited("image_width: 160", "fisheye_model: 2\nimage_width: 160")),
+             Catch::Contains("fisheye_model must be 0 (pinhole) or 1"));
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: equidistant\nimage_width: 160")),
              Catch::Contains("distortion_model 'equidistant' is not supported"));
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: rational_polynomial\nimage_width: 160")),

@@ -10,10 +10,15 @@ Undistorter::Undistorter(const vision::Camera& camera) : camera_(camera) {
   const auto& k = camera.intrinsics();
   const cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
   const auto& d = camera.distortion();
-  const cv::Vec<double, 5> dist(d[0], d[1], d[2], d[3], d[4]);
+  const cv::Size size(camera.width_px(), camera.height_px());
   // The tables are computed once; remap per frame is then a lookup.
-  cv::initUndistortRectifyMap(K, dist, cv::noArray(), K, cv::Size(camera.width_px(), camera.height_px()), CV_16SC2,
-                              map1_, map2_);
+  if (camera.lens() == vision::LensModel::Fisheye) {
+    const cv::Vec4d dist(d[0], d[1], d[2], d[3]);
+    cv::fisheye::initUndistortRectifyMap(K, dist, cv::Matx33d::eye(), K, size, CV_16SC2, map1_, map2_);
+  } else {
+    const cv::Vec<double, 5> dist(d[0], d[1], d[2], d[3], d[4]);
+    cv::initUndistortRectifyMap(K, dist, cv::noArray(), K, size, CV_16SC2, map1_, map2_);
+  }
 }
 
 std::expected<void, std::string> Undistorter::to_grey_undistorted(const cv::Mat& frame, cv::Mat& grey_out) {

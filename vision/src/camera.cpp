@@ -97,22 +97,23 @@ std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const
 
 // A calibration for another camera model than the pinhole with k1 k2 p1 p2 k3 is an error: read
 // as this one, it would project pixels off without a word.
-std::expected<void, std::string> check_model(const cv::FileStorage& fs, const std::string& path) {
-  const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes
-  if (!fisheye.empty() && !fisheye.isNone() && !(fisheye.isInt() && static_cast<int>(fisheye) == 0))
-    return Error(path + ": a fisheye calibration (fisheye_model) is not supported: only the pinhole model with "
-                        "distortion k1 k2 p1 p2 k3");
+std::expected<LensModel, std::string> read_lens(const cv::FileStorage& fs, const std::string& path) {
   const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
   if (!model.empty() && !model.isNone()) {
     const std::string name = model.isString() ? model.string() : std::string("(not a name)");
     if (name != "plumb_bob")
       return Error(path + ": distortion_model '" + name + "' is not supported: only plumb_bob (k1 k2 p1 p2 k3)");
   }
-  return {};
+  const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes: 1
+  if (fisheye.empty() || fisheye.isNone()) return LensModel::Pinhole;
+  if (!fisheye.isInt() || (static_cast<int>(fisheye) != 0 && static_cast<int>(fisheye) != 1))
+    return Error(path + ": fisheye_model must be 0 (pinhole) or 1 (cv::fisheye's equidistant model)");
+  return static_cast<int>(fisheye) == 1 ? LensModel::Fisheye : LensModel::Pinhole;
 }
 
 std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path) {
-  if (auto ok = check_model(fs, path); !ok) return Error(ok.error());
+  auto lens = read_lens(fs, path);
+  if (!lens) return Error(lens.error());
   auto width = read_size(fs, path, "image_width");
   if (!width) return Error(width.error());
   auto height = read_size(fs, path, "image_height");
@@ -138,6 +139,9 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
     if (d->rows != 1 && d->cols != 1)
       return Error(path + ": distortion_coefficients must be a row or column vector, got " + shape(*d));
     const int n = static_cast<int>(d->total());
+    if (*lens == LensModel::Fisheye && n != 4)
+      return Error(path + ": a fisheye calibration (fisheye_model: 1) must have 4 distortion_coefficients (k1..k4), got " +
+                   std::to_string(n));
     if (n == 8 || n == 12 || n == 14)
       return Error(path + ": distortion_coefficients has " + std::to_string(n) +
                    " values (rational / thin-prism / tilted model); only k1 k2 p1 p2 k3 (4 or 5 values) is supported");
@@ -145,20 +149,24 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
       return Error(path + ": distortion_coefficients must have 0, 4 or 5 values, got " + std::to_string(n));
     for (int i = 0; i < n; ++i) dist[static_cast<std::size_t>(i)] = d->at<double>(i);
   }
-  return Camera(*width, *height, in, dist);
+  return Camera(*width, *height, in, dist, *lens);
 }
 
 }  // namespace
 
-Camera::Camera(int width_px, int height_px, const Intrinsics& k, const Distortion& distortion)
-    : width_px_(width_px), height_px_(height_px), k_(k), dist_(distortion) {
+Camera::Camera(int width_px, int height_px, const Intrinsics& k, const Distortion& distortion, LensModel lens)
+    : width_px_(width_px), height_px_(height_px), k_(k), dist_(distortion), lens_(lens) {
   if (width_px <= 0 || height_px <= 0) throw std::invalid_argument("Camera: image size must be positive");
   if (!(k.fx_px > 0) || !(k.fy_px > 0) || !std::isfinite(k.fx_px) || !std::isfinite(k.fy_px))
     throw std::invalid_argument("Camera: focal lengths must be positive and finite");
   if (!std::isfinite(k.cx_px) || !std::isfinite(k.cy_px)) throw std::invalid_argument("Camera: principal point must be finite");
   for (double c : dist_)
     if (!std::isfinite(c)) throw std::invalid_argument("Camera: distortion coefficients must be finite");
-  has_distortion_ = std::any_of(dist_.begin(), dist_.end(), [](double c) { return c != 0; });
+  if (lens_ == LensModel::Fisheye && dist_[4] != 0)
+    throw std::invalid_argument("Camera: the fisheye model has four distortion coefficients; the fifth must be 0");
+  // A fisheye lens bends rays even with k1..k4 zero (theta, not tan theta, is proportional to
+  // the distance from the principal point).
+  has_distortion_ = lens_ == LensModel::Fisheye || std::any_of(dist_.begin(), dist_.end(), [](double c) { return c != 0; });
 }
 
 std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
@@ -202,8 +210,10 @@ std::expected<void, std::string> Camera::save(const std::string& yaml_path) cons
     if (!fs.isOpened()) return Error(yaml_path + ": cannot open for writing");
     fs << "image_width" << width_px_ << "image_height" << height_px_;
     const cv::Mat K = (cv::Mat_<double>(3, 3) << k_.fx_px, 0, k_.cx_px, 0, k_.fy_px, k_.cy_px, 0, 0, 1);
-    cv::Mat d(1, 5, CV_64F);
-    for (int i = 0; i < 5; ++i) d.at<double>(i) = dist_[static_cast<std::size_t>(i)];
+    const int n = lens_ == LensModel::Fisheye ? 4 : 5;
+    cv::Mat d(1, n, CV_64F);
+    for (int i = 0; i < n; ++i) d.at<double>(i) = dist_[static_cast<std::size_t>(i)];
+    if (lens_ == LensModel::Fisheye) fs << "fisheye_model" << 1;
     fs << "camera_matrix" << K << "distortion_coefficients" << d;
     fs.release();
   } catch (const cv::Exception& e) {
@@ -218,9 +228,33 @@ Eigen::Matrix3d Camera::K() const {
   return K;
 }
 
+namespace {
+
+// The fisheye model as a radial scale: x_d = s(r) x with r = |x| and s(r) = theta_d(atan r) / r,
+// and ds/dr / r for the Jacobian. Near the axis the series (s = 1 + (k1 - 1/3) r^2 + ...)
+// replaces the 0/0.
+struct FisheyeScale {
+  double s, ds_dr_over_r;
+};
+FisheyeScale fisheye_scale(const Distortion& d, double r2) {
+  const auto [k1, k2, k3, k4, unused] = d;
+  if (r2 < 1e-16) return {1.0, 2 * (k1 - 1.0 / 3.0)};
+  const double r = std::sqrt(r2), theta = std::atan(r), t2 = theta * theta;
+  const double theta_d = theta * (1 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
+  const double dtheta_d = 1 + t2 * (3 * k1 + t2 * (5 * k2 + t2 * (7 * k3 + t2 * 9 * k4)));
+  const double dtheta_dr = 1 / (1 + r2);
+  return {theta_d / r, (dtheta_d * dtheta_dr * r - theta_d) / (r2 * r)};
+}
+
+}  // namespace
+
 Eigen::Vector2d Camera::normalized_to_pixel(const Eigen::Vector2d& xn) const {
   const double x = xn.x(), y = xn.y();
   if (!has_distortion_) return {k_.fx_px * x + k_.cx_px, k_.fy_px * y + k_.cy_px};
+  if (lens_ == LensModel::Fisheye) {
+    const double s = fisheye_scale(dist_, x * x + y * y).s;
+    return {k_.fx_px * s * x + k_.cx_px, k_.fy_px * s * y + k_.cy_px};
+  }
   const auto [k1, k2, p1, p2, k3] = dist_;
   const double r2 = x * x + y * y;
   const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
@@ -231,7 +265,10 @@ Eigen::Vector2d Camera::normalized_to_pixel(const Eigen::Vector2d& xn) const {
 
 Eigen::Matrix2d Camera::normalized_to_pixel_jacobian(const Eigen::Vector2d& xn) const {
   Eigen::Matrix2d J = Eigen::Matrix2d::Identity();
-  if (has_distortion_) {
+  if (has_distortion_ && lens_ == LensModel::Fisheye) {
+    const FisheyeScale f = fisheye_scale(dist_, xn.squaredNorm());
+    J = f.s * Eigen::Matrix2d::Identity() + f.ds_dr_over_r * xn * xn.transpose();
+  } else if (has_distortion_) {
     const double x = xn.x(), y = xn.y();
     const auto [k1, k2, p1, p2, k3] = dist_;
     const double r2 = x * x + y * y;

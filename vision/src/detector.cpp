@@ -162,6 +162,14 @@ DetectionHypothesis Detector::Impl::measure(DetectionHypothesis h, bool whole_ob
   return h;
 }
 
+void Detector::Impl::choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const {
+  if (symmetries.empty()) return;
+  if (const auto& like = prior.orient_like ? prior.orient_like : prior.near_cam_T_obj; like)
+    h.cam_T_obj = symmetric_nearest(h.cam_T_obj, symmetries, *like);
+  else if (prior.up_cam && prior.up_obj)
+    h.cam_T_obj = symmetric_upright(h.cam_T_obj, symmetries, *prior.up_obj, *prior.up_cam);
+}
+
 Detector::Detector(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Detector::~Detector() = default;
 int Detector::template_count() const { return static_cast<int>(impl_->specs.size()); }
@@ -235,6 +243,7 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(),
                    [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
   result.refine_ms += ms_since(t1);
+  for (DetectionHypothesis& h : result.hypotheses) d.choose_symmetric(h, prior);
   if (!result.hypotheses.empty()) {
     result.best = result.hypotheses.front();
     result.found = d.verified(result.best);

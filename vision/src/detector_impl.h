@@ -12,6 +12,7 @@
 
 #include "edge_support.h"
 #include "epichead/vision/detector.h"
+#include "epichead/vision/model_symmetry.h"
 #include "template_cache.h"
 
 namespace epichead::vision {
@@ -26,7 +27,7 @@ inline std::string class_id(int view, int roll) { return "v" + std::to_string(vi
 struct Detector::Impl {
   Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
       : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
-        tracker(model_storage, c, t), visibility(model_storage, c, t.visibility) {}
+        tracker(model_storage, c, t), visibility(model_storage, c, t.visibility), symmetries(model_symmetries(m)) {}
 
   // The pull's windows are twice as wide as tracking's: a template's pose can be off by more
   // than a frame's motion.
@@ -60,6 +61,9 @@ struct Detector::Impl {
   double radius_m = 0;
   std::vector<Eigen::Vector3d> outline_obj;  // model points whose projections stand for a pose's outline
   std::vector<Eigen::Vector2d> scratch_outline;
+  // The model's own symmetries (model_symmetry.h): poses that differ by one draw the same
+  // outline, so the search cannot choose among them; the prior can (choose_symmetric).
+  std::vector<Eigen::Isometry3d> symmetries;
 
   void project_outline(const Eigen::Isometry3d& T, std::vector<Eigen::Vector2d>& px) const {
     px.clear();
@@ -94,6 +98,11 @@ struct Detector::Impl {
   DetectionHypothesis measure(DetectionHypothesis h, bool whole_object = true);
   // Takes a frame: the matcher's BGR (padded), the grey gradients and the tracker's image.
   std::expected<cv::Mat, std::string> take_frame(const cv::Mat& frame);
+  // Among h's pose and its symmetric equivalents, the one nearest the prior: the turn closest
+  // to orient_like's or the predicted pose's, or else the one that puts the object's up nearest
+  // the world's.
+  // A can found again after a cover is otherwise as likely upside down (issue 19).
+  void choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const;
   bool verified(const DetectionHypothesis& h) const {
     return h.support >= options.min_support && h.supported_px >= options.min_supported_px;
   }

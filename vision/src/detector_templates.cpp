@@ -67,6 +67,7 @@ std::uint64_t Detector::Impl::key() const {
   h.bytes(K.data(), sizeof(double) * 9);
   const auto& d = camera.distortion();
   h.bytes(&d, sizeof d);
+  h.value(static_cast<int>(camera.lens()));
   h.value(options.view_subdivisions);
   h.value(options.in_plane_step_deg);
   for (double m : distances_m) h.value(m);

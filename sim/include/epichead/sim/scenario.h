@@ -43,6 +43,8 @@ struct CoverWindow {
   double duration_s = 1;  // for this long
   // The board is in front of the camera (sliding or still) at t_s.
   bool board_in_view(double t_s) const { return t_s >= start_s - kSlideS && t_s <= start_s + duration_s + kSlideS; }
+  // The board hides the whole object at t_s.
+  bool hides_object(double t_s) const { return t_s >= start_s && t_s <= start_s + duration_s; }
 };
 
 struct Scenario {

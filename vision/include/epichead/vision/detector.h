@@ -92,6 +92,11 @@ struct DetectionPrior {
   // Refined and verified first (the tracker's last or predicted pose): when it is found there,
   // the global search is skipped.
   std::optional<Eigen::Isometry3d> near_cam_T_obj;
+  // Poses that differ by one of the model's symmetries draw the same outline (a can upside
+  // down): the found pose is reported as the one whose turn is nearest this, or near_cam_T_obj,
+  // or else the one that puts up_obj nearest up_cam. Unlike near_cam_T_obj it does not narrow
+  // the search (a recheck of the tracked pose).
+  std::optional<Eigen::Isometry3d> orient_like;
 };
 
 class Detector {
