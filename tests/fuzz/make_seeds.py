@@ -36,6 +36,18 @@ def cao(out):
 def camera(out):
     for p in [ROOT / "tests/data/seq/camera.yaml", SHARED / "teabox/camera.yaml", SHARED / "teabox_left/camera.yaml"]:
         write(out, "camera_yaml", p.parent.name, p.read_bytes())
+    # As a cv::fisheye calibration is saved: fisheye_model: 1 and k1..k4.
+    write(out, "camera_yaml", "fisheye",
+          "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nfisheye_model: 1\n"
+          "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+          "   data: [ 210., 0., 318.5, 0., 212., 241.25, 0., 0., 1. ]\n"
+          "distortion_coefficients: !!opencv-matrix\n   rows: 4\n   cols: 1\n   dt: d\n"
+          "   data: [ 0.08, -0.03, 0.01, -0.002 ]\n")
+    # As ROS's camera_calibration writes camera_info: plain YAML, no directive, no dt.
+    write(out, "camera_yaml", "ros_camera_info",
+          "image_width: 640\nimage_height: 480\ncamera_name: head_camera\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+          "  data: [500.0, 0.0, 320.5, 0.0, 505.0, 240.25, 0.0, 0.0, 1.0]\ndistortion_model: plumb_bob\n"
+          "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.1, 0.01, 0.001, 0.002, 0.0005]\n")
 
 
 def csvs(out):

@@ -369,3 +369,39 @@ TEST_CASE("a calibration cv::fisheye wrote loads as the fisheye model and saves 
   CHECK(reread->distortion() == written.distortion());
   CHECK((reread->project(p) - written.project(p)).norm() == 0.0);
 }
+
+namespace {
+
+// What ROS's camera_calibration writes (camera_info YAML): plain YAML, matrices as {rows, cols, data}.
+std::string ros_camera_info(const std::string& model, const std::string& coefficients, int n) {
+  return "image_width: 640\nimage_height: 480\ncamera_name: head_camera\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+         "  data: [500.0, 0.0, 320.5, 0.0, 505.0, 240.25, 0.0, 0.0, 1.0]\ndistortion_model: " + model +
+         "\ndistortion_coefficients:\n  rows: 1\n  cols: " + std::to_string(n) + "\n  data: [" + coefficients +
+         "]\nrectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]\n"
+         "projection_matrix:\n  rows: 3\n  cols: 4\n  data: [500.0, 0.0, 320.5, 0.0, 0.0, 505.0, 240.25, 0.0, 0.0, 0.0, 1.0, 0.0]\n";
+}
+
+}  // namespace
+
+TEST_CASE("a ROS camera_info YAML loads: plumb_bob as the pinhole model, equidistant as the fisheye, and another model is an error") {
+  TempDir dir;
+  auto pinhole = Camera::load(dir.write("camera_info.yaml", ros_camera_info("plumb_bob", "-0.1, 0.01, 0.001, 0.002, 0.0005", 5)));
+  REQUIRE(pinhole);
+  CHECK(pinhole->lens() == epichead::vision::LensModel::Pinhole);
+  CHECK(pinhole->width_px() == 640);
+  CHECK(pinhole->intrinsics().fy_px == 505.0);
+  CHECK(pinhole->intrinsics().cx_px == 320.5);
+  CHECK(pinhole->distortion() == Distortion{-0.1, 0.01, 0.001, 0.002, 0.0005});
+
+  auto fisheye = Camera::load(dir.write("fisheye.yaml", ros_camera_info("equidistant", "0.08, -0.03, 0.01, -0.002", 4)));
+  REQUIRE(fisheye);
+  CHECK(fisheye->lens() == epichead::vision::LensModel::Fisheye);
+  CHECK(fisheye->distortion() == Distortion{0.08, -0.03, 0.01, -0.002, 0.0});
+
+  auto rational = Camera::load(dir.write("rational.yaml", ros_camera_info("rational_polynomial", "0.1, 0.01, 0, 0, 0, 0.1, 0.01, 0", 8)));
+  REQUIRE_FALSE(rational);
+  CHECK_THAT(rational.error(), Catch::Contains("rational.yaml: distortion_model 'rational_polynomial' is not supported"));
+  auto five = Camera::load(dir.write("five.yaml", ros_camera_info("equidistant", "0.08, -0.03, 0.01, -0.002, 0", 5)));
+  REQUIRE_FALSE(five);
+  CHECK_THAT(five.error(), Catch::Contains("must have 4 distortion_coefficients (k1..k4), got 5"));
+}

@@ -92,8 +92,9 @@ TEST_CASE("A calibration model the reader does not support is an error, never re
              Catch::Contains("must have 4 distortion_coefficients (k1..k4), got 5"));
   CHECK_THAT(load_error(edited("image_width: 160", "fisheye_model: 2\nimage_width: 160")),
              Catch::Contains("fisheye_model must be 0 (pinhole) or 1"));
+  // ROS's equidistant is the fisheye model: k1..k4, not the five of this file.
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: equidistant\nimage_width: 160")),
-             Catch::Contains("distortion_model 'equidistant' is not supported"));
+             Catch::Contains("must have 4 distortion_coefficients (k1..k4), got 5"));
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: rational_polynomial\nimage_width: 160")),
              Catch::Contains("distortion_model 'rational_polynomial' is not supported"));
   epichead::testing::TempDir dir("epichead_test_camera_bad");

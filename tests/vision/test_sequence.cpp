@@ -316,3 +316,21 @@ TEST_CASE("video frames of another size than the calibration are an error naming
   CHECK_THAT(bad.error(), Catch::Contains("video.mp4 frame 0") && Catch::Contains("640x480") &&
                               Catch::Contains("calibration for 320x240"));
 }
+
+TEST_CASE("the calibration may be camera.yml or camera_info.yaml, and two calibrations in one sequence are an error naming both") {
+  TempDir dir;
+  write_image_sequence(dir, 2);
+  const std::string base = dir.str() + "/";
+  for (const char* name : {"camera.yml", "camera_info.yaml"}) {
+    std::filesystem::rename(base + "camera.yaml", base + name);
+    auto seq = Sequence::open(dir.str());
+    INFO(name);
+    REQUIRE(seq.has_value());
+    CHECK(seq->camera().width_px() == 160);
+    std::filesystem::rename(base + name, base + "camera.yaml");
+  }
+  std::filesystem::copy_file(base + "camera.yaml", base + "camera_info.yaml");
+  auto both = Sequence::open(dir.str());
+  REQUIRE_FALSE(both.has_value());
+  CHECK_THAT(both.error(), Catch::Contains("holds both camera.yaml and camera_info.yaml"));
+}

@@ -61,7 +61,9 @@ std::expected<int, std::string> read_dimension(const cv::FileNode& matrix, const
 // Reads an opencv-matrix field (rows, cols, dt, data) as CV_64F. Decoded here rather than by
 // OpenCV's `node >> mat`, which allocates rows x cols x element size before it looks at the
 // data: a one-character typo in rows or cols asks it for tens of gigabytes.
-std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const std::string& path, const char* field) {
+// ros: a ROS camera_info file, whose matrices are plain maps {rows, cols, data} of doubles.
+std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const std::string& path, const char* field,
+                                                bool ros) {
   const cv::FileNode node = fs[field];
   if (node.empty() || node.isNone()) return Error(path + ": missing field '" + field + "'");
   if (!node.isMap()) return Error(path + ": " + field + " must be an opencv-matrix (rows, cols, dt, data)");
@@ -70,8 +72,9 @@ std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const
   auto cols = read_dimension(node, path, field, "cols");
   if (!cols) return Error(cols.error());
   const cv::FileNode dt = node["dt"];
-  if (!dt.isString()) return Error(path + ": " + field + ".dt must be an element type such as d");
-  const std::string type = dt.string();
+  const bool plain = ros && (dt.empty() || dt.isNone());
+  if (!plain && !dt.isString()) return Error(path + ": " + field + ".dt must be an element type such as d");
+  const std::string type = plain ? std::string("d") : dt.string();
   if (type.size() != 1 || std::string_view("ucwsifdh").find(type[0]) == std::string_view::npos)
     return Error(path + ": " + field + " must have one channel of a number type (dt: d), got dt: " + type);
   const int n = *rows * *cols;
@@ -97,12 +100,24 @@ std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const
 
 // A calibration for another camera model than the pinhole with k1 k2 p1 p2 k3 is an error: read
 // as this one, it would project pixels off without a word.
+// ROS camera_info YAML (camera_calibration's output): its keys at the start of a line.
+bool is_ros_camera_info(std::string_view text) {
+  const auto has_key = [&](std::string_view key) {
+    for (std::size_t at = text.find(key); at != std::string_view::npos; at = text.find(key, at + 1))
+      if (at == 0 || text[at - 1] == '\n') return true;
+    return false;
+  };
+  return has_key("camera_matrix:") && has_key("distortion_model:");
+}
+
 std::expected<LensModel, std::string> read_lens(const cv::FileStorage& fs, const std::string& path) {
   const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
   if (!model.empty() && !model.isNone()) {
     const std::string name = model.isString() ? model.string() : std::string("(not a name)");
-    if (name != "plumb_bob")
-      return Error(path + ": distortion_model '" + name + "' is not supported: only plumb_bob (k1 k2 p1 p2 k3)");
+    if (name == "plumb_bob") return LensModel::Pinhole;
+    if (name == "equidistant") return LensModel::Fisheye;  // ROS's name for cv::fisheye's model
+    return Error(path + ": distortion_model '" + name +
+                 "' is not supported: only plumb_bob (k1 k2 p1 p2 k3) and equidistant (k1..k4)");
   }
   const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes: 1
   if (fisheye.empty() || fisheye.isNone()) return LensModel::Pinhole;
@@ -111,7 +126,7 @@ std::expected<LensModel, std::string> read_lens(const cv::FileStorage& fs, const
   return static_cast<int>(fisheye) == 1 ? LensModel::Fisheye : LensModel::Pinhole;
 }
 
-std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path) {
+std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path, bool ros) {
   auto lens = read_lens(fs, path);
   if (!lens) return Error(lens.error());
   auto width = read_size(fs, path, "image_width");
@@ -119,7 +134,7 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
   auto height = read_size(fs, path, "image_height");
   if (!height) return Error(height.error());
 
-  auto k = read_matrix(fs, path, "camera_matrix");
+  auto k = read_matrix(fs, path, "camera_matrix", ros);
   if (!k) return Error(k.error());
   if (k->rows != 3 || k->cols != 3) return Error(path + ": camera_matrix must be 3x3, got " + shape(*k));
   const cv::Mat& K = *k;
@@ -132,7 +147,7 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
   if (K.at<double>(1, 0) != 0 || K.at<double>(2, 0) != 0 || K.at<double>(2, 1) != 0 || K.at<double>(2, 2) != 1)
     return Error(path + ": camera_matrix must have the form [fx 0 cx; 0 fy cy; 0 0 1]");
 
-  auto d = read_matrix(fs, path, "distortion_coefficients");
+  auto d = read_matrix(fs, path, "distortion_coefficients", ros);
   if (!d) return Error(d.error());
   Distortion dist{};
   if (!d->empty()) {
@@ -140,8 +155,8 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
       return Error(path + ": distortion_coefficients must be a row or column vector, got " + shape(*d));
     const int n = static_cast<int>(d->total());
     if (*lens == LensModel::Fisheye && n != 4)
-      return Error(path + ": a fisheye calibration (fisheye_model: 1) must have 4 distortion_coefficients (k1..k4), got " +
-                   std::to_string(n));
+      return Error(path + ": a fisheye calibration (fisheye_model: 1, distortion_model: equidistant) must have 4 "
+                          "distortion_coefficients (k1..k4), got " + std::to_string(n));
     if (n == 8 || n == 12 || n == 14)
       return Error(path + ": distortion_coefficients has " + std::to_string(n) +
                    " values (rational / thin-prism / tilted model); only k1 k2 p1 p2 k3 (4 or 5 values) is supported");
@@ -183,13 +198,16 @@ std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.empty()) return Error(yaml_path + ": empty file (expected OpenCV FileStorage YAML)");
   if (auto ok = precheck_camera_yaml(text); !ok) return Error(yaml_path + ": not a camera YAML: " + ok.error());
-  // OpenCV's YAML reader insists on the directive line; saying so beats its "Input file is invalid".
+  // OpenCV's YAML reader insists on the directive line. A ROS camera_info file is plain YAML
+  // without it and gets one; for anything else, saying so beats OpenCV's "Input file is invalid".
+  const bool ros = !text.starts_with("%YAML") && is_ros_camera_info(text);
+  if (ros) text.insert(0, "%YAML:1.0\n---\n");
   const std::string hint = text.starts_with("%YAML") ? "" : "; it must start with %YAML:1.0";
   try {
     cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) return Error(yaml_path + ": cannot open as OpenCV FileStorage YAML" + hint);
     if (!fs.root().isMap()) return Error(yaml_path + ": not an OpenCV FileStorage YAML mapping");
-    return load_from(fs, yaml_path);
+    return load_from(fs, yaml_path, ros);
   } catch (const cv::Exception& e) {
     // OpenCV's parser throws on text that is not YAML.
     return Error(yaml_path + ": not OpenCV FileStorage YAML (" + opencv_reason(e) + hint + ")");

@@ -63,7 +63,15 @@ std::expected<Sequence, std::string> Sequence::open(const std::string& dir) {
   seq.dir_ = dir;
   const std::string base = dir + "/";
 
-  auto camera = Camera::load(base + "camera.yaml");
+  // The calibration under the names people give it: OpenCV's samples write .yml, ROS's
+  // camera_calibration camera_info.yaml. Two of them would leave it to chance: an error.
+  std::vector<std::string> calibrations;
+  for (const char* name : kCameraFileNames)
+    if (is_file(base + name)) calibrations.push_back(name);
+  if (calibrations.size() > 1)
+    return Error(dir + ": holds both " + calibrations[0] + " and " + calibrations[1] + "; keep the one calibration");
+  seq.camera_file_ = base + (calibrations.empty() ? kCameraFileNames[0] : calibrations[0]);
+  auto camera = Camera::load(seq.camera_file_);
   if (!camera) return Error(camera.error());
   seq.camera_ = std::move(*camera);
 
@@ -151,7 +159,7 @@ std::expected<Sequence, std::string> Sequence::open(const std::string& dir) {
 std::expected<void, std::string> Sequence::check_size(const cv::Mat& image, const std::string& what) const {
   if (image.cols == camera_.width_px() && image.rows == camera_.height_px()) return {};
   return Error(what + ": the image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but " +
-               dir_ + "/camera.yaml is a calibration for " + std::to_string(camera_.width_px()) + "x" +
+               camera_file_ + " is a calibration for " + std::to_string(camera_.width_px()) + "x" +
                std::to_string(camera_.height_px()));
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// A sequence directory (DESIGN.md): camera.yaml, model.cao, frames (frames.csv + images, or
+// A sequence directory (DESIGN.md): camera.yaml (or camera.yml, camera_info.yaml), model.cao, frames (frames.csv + images, or
 // video.mp4), optional init.csv (without it the object is detected), imu.csv and gt.csv. Real and simulated sequences read alike.
 #include <expected>
 #include <memory>
@@ -27,6 +27,9 @@ struct FrameEntry {
   double t_s = 0;
   std::string file;  // relative to the directory; empty when frames come from video.mp4
 };
+
+// The names a sequence's camera calibration may have, the first preferred.
+inline constexpr const char* kCameraFileNames[] = {"camera.yaml", "camera.yml", "camera_info.yaml"};
 
 class Sequence {
  public:
@@ -61,6 +64,7 @@ class Sequence {
  private:
   Sequence();
   std::string dir_;
+  std::string camera_file_;  // the calibration read (one of kCameraFileNames)
   Camera camera_;
   CadModel model_;
   StampedPose init_{-1, 0.0, Eigen::Isometry3d::Identity(), ""};
