@@ -98,8 +98,6 @@ std::expected<cv::Mat, std::string> read_matrix(const cv::FileStorage& fs, const
   return m;
 }
 
-// A calibration for another camera model than the pinhole with k1 k2 p1 p2 k3 is an error: read
-// as this one, it would project pixels off without a word.
 // ROS camera_info YAML (camera_calibration's output): its keys at the start of a line.
 bool is_ros_camera_info(std::string_view text) {
   const auto has_key = [&](std::string_view key) {
@@ -110,6 +108,9 @@ bool is_ros_camera_info(std::string_view text) {
   return has_key("camera_matrix:") && has_key("distortion_model:");
 }
 
+// The lens model the file names (ROS's distortion_model, or cv::fisheye's fisheye_model). A
+// model this reader does not know is an error: read as another, it would project pixels off
+// without a word.
 std::expected<LensModel, std::string> read_lens(const cv::FileStorage& fs, const std::string& path) {
   const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
   if (!model.empty() && !model.isNone()) {
