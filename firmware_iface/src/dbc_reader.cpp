@@ -52,13 +52,25 @@ std::string shown(std::string_view rest) {
 
 // A DBC string as UTF-8 on one line: files from Windows tools are often Latin-1 / cp1252
 // ("°C" as one byte 0xB0), which is re-encoded; control characters become '?'.
+// Well-formed UTF-8 as RFC 3629 has it (no overlong forms, surrogates or code points past
+// U+10FFFF), which JSON writers insist on.
 bool valid_utf8(std::string_view s) {
+  const auto at = [&](std::size_t i) { return i < s.size() ? static_cast<unsigned char>(s[i]) : 0u; };
   for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    const int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xE ? 2 : (c >> 3) == 0x1E ? 3 : -1;
-    if (n < 0 || i + static_cast<std::size_t>(n) >= s.size()) return false;
-    for (int k = 1; k <= n; ++k)
-      if ((static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]) & 0xC0) != 0x80) return false;
+    const unsigned c = at(i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    int n = 0;          // continuation bytes
+    unsigned lo = 0x80, hi = 0xBF;  // the range of the first of them
+    if (c >= 0xC2 && c <= 0xDF) n = 1;
+    else if (c >= 0xE0 && c <= 0xEF) n = 2, lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+    else if (c >= 0xF0 && c <= 0xF4) n = 3, lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+    else return false;
+    if (at(i + 1) < lo || at(i + 1) > hi) return false;
+    for (int k = 2; k <= n; ++k)
+      if ((at(i + static_cast<std::size_t>(k)) & 0xC0) != 0x80) return false;
     i += static_cast<std::size_t>(n) + 1;
   }
   return true;

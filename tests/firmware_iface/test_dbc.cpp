@@ -273,6 +273,20 @@ TEST_CASE("Malformed DBC input gives one error naming the file, the line and wha
   CHECK(missing.error() == "/nonexistent/x.dbc: cannot open (No such file or directory)");
 }
 
+TEST_CASE("Units and VAL_ texts come out as well-formed UTF-8 on one line, whatever the file's bytes") {
+  // "°C" in UTF-8 stays; 0xF5.. (no UTF-8 lead byte), an overlong "/" (C0 AF), a surrogate
+  // (ED A0 80) and a cut sequence are taken as Latin-1; control characters become '?'.
+  const auto unit_of = [](const std::string& unit) {
+    return parse(kHeader + "BO_ 1 A: 8 N\n SG_ s : 0|8@1+ (1,0) [0|0] \"" + unit + "\" N\n").messages.at(0).signals.at(0).unit;
+  };
+  CHECK(unit_of("\xC2\xB0" "C") == "\xC2\xB0" "C");
+  CHECK(unit_of("\xF5\x80\x80\x80") == "\xC3\xB5\xC2\x80\xC2\x80\xC2\x80");
+  CHECK(unit_of("\xC0\xAF") == "\xC3\x80\xC2\xAF");
+  CHECK(unit_of("\xED\xA0\x80") == "\xC3\xAD\xC2\xA0\xC2\x80");
+  CHECK(unit_of("a\xE2\x82") == "a\xC3\xA2\xC2\x82");
+  CHECK(unit_of("a\tb") == "a?b");
+}
+
 TEST_CASE("Text that is not a DBC reads as an empty database or an error, never more") {
   CHECK(parse("").messages.empty());
   CHECK(parse("hello world\n\x01\x02\x03\n").messages.empty());

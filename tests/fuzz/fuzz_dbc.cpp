@@ -3,8 +3,11 @@
 // database or a one-line error naming the input and a line within it, never a crash or a hang;
 // a database's messages have lengths 0..64, unique ids, ids within 29 bits (11 when not
 // extended), signals of 1..64 bits inside 64 bytes, finite factors and ranges, a multiplexor
-// for every multiplexed signal; the same text from a file reads the same; decoding reads no
+// for every multiplexed signal; units and value texts are well-formed UTF-8 (the JSON report
+// takes them); the same text from a file reads the same; decoding reads no
 // byte past the frame, and bits written with insert_bits read back.
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <set>
 #include <string>
@@ -18,6 +21,16 @@ using namespace epichead::firmware_iface;
 using epichead::fuzz::check;
 
 namespace {
+
+// The replay report writes units into JSON, whose writer throws on text that is not UTF-8.
+bool json_safe(const std::string& text) {
+  try {
+    (void)nlohmann::json(text).dump();
+    return true;
+  } catch (const nlohmann::json::exception&) {
+    return false;
+  }
+}
 
 void check_database(const Dbc& d, std::size_t lines) {
   std::set<std::uint64_t> ids;
@@ -36,8 +49,12 @@ void check_database(const Dbc& d, std::size_t lines) {
       check(s.value_type == SignalValueType::Integer || s.length == (s.value_type == SignalValueType::Float32 ? 32 : 64),
             "a float signal of the wrong width");
       multiplexed |= s.multiplexing == Multiplexing::Multiplexed;
-      for (const auto& [raw, text] : s.values) epichead::fuzz::check_one_line(text.empty() ? "x" : text, "value text");
+      for (const auto& [raw, text] : s.values) {
+        epichead::fuzz::check_one_line(text.empty() ? "x" : text, "value text");
+        check(json_safe(text), "a value text is not well-formed UTF-8");
+      }
       check(s.unit.find('\n') == std::string::npos, "a unit spans lines");
+      check(json_safe(s.unit), "a unit is not well-formed UTF-8 (the JSON report would throw)");
     }
     check(!multiplexed || (m.multiplexor >= 0 && static_cast<std::size_t>(m.multiplexor) < m.signals.size()),
           "multiplexed signals without a multiplexor");

@@ -5,6 +5,7 @@
 // values outside the DBC's [min|max]; series of the chosen signals for a plot; and every
 // decoded value to a sink (the --csv writer). Memory is bounded by the DBCs' size, not the log's.
 #include <cstdint>
+#include <expected>
 #include <functional>
 #include <limits>
 #include <map>
