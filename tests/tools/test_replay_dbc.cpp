@@ -120,6 +120,25 @@ TEST_CASE("Replay --signal plots the chosen signals into the --plot folder or a 
   CHECK(std::filesystem::file_size(dir / "sub/v.png") > 10000);
 }
 
+TEST_CASE("Replay --dbc decodes the last byte of the real log's 64-byte CAN FD frames") {
+  // rocketcan_canfd_vcan1.log: 1F334455 in 9 frames, 2 of them 64 bytes long ending in 88
+  // (awk over the data lengths: 64 x2, 32 x4, 8 x3).
+  TempDir dir("replay_dbc_fd");
+  std::ofstream(dir / "fd.dbc") << "BO_ 2670937173 FdMsg: 64 N\n"  // 0x80000000 | 0x1F334455
+                                  " SG_ first : 0|8@1+ (1,0) [0|0] \"\" N\n"
+                                  " SG_ last : 504|8@1+ (1,0) [0|0] \"\" N\n";
+  const json j = replay_json(dir, shared("rocketcan_canfd_vcan1.log") + " --dbc " + shell_quoted(dir / "fd.dbc"));
+  const json& fd = message(j, "FdMsg");
+  CHECK(fd["id"] == "0x1F334455");
+  CHECK(fd["count"] == 9);
+  CHECK(fd["other_length"] == 7);
+  CHECK(fd["too_short"] == 7);
+  CHECK(fd["signals"]["first"]["count"] == 9);
+  CHECK(fd["signals"]["last"]["count"] == 2);
+  CHECK(fd["signals"]["last"]["min"] == 0x88);
+  CHECK(fd["signals"]["last"]["max"] == 0x88);
+}
+
 TEST_CASE("Replay with epichead.dbc compares each message's period with its GenMsgCycleTime") {
   TempDir dir("replay_dbc_cycle");
   const std::string path = dir / "bus.log";
