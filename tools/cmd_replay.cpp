@@ -1,4 +1,5 @@
-// `epichead replay LOG [--json] [--plot DIR] [--bitrate B] [--data-bitrate B] [--imu-protocol P]`:
+// `epichead replay LOG [--json] [--plot DIR] [--bitrate B] [--data-bitrate B] [--imu-protocol P]
+//  [--dbc FILE... [--csv FILE] [--signal MESSAGE.SIGNAL]... [--signal-plot PNG]]`:
 // decodes a candump log with the epichead protocol (and DroneCAN RawIMU) and reports per CAN id
 // and per message type: count, rate, gaps and jitter, counter losses and duplicates,
 // out-of-range values, fault bits, bus load; frames of other protocols are counted per id.
@@ -148,7 +149,7 @@ const CommandRegistration registration{
       auto o = std::make_shared<Options>();
       app.add_option("LOG", o->log, "candump log (candump -l format, or candump's default output)")->required();
       app.add_flag("--json", o->json, "Print one JSON object instead of the text report");
-      app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png and attitude.png into this directory");
+      app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png and attitude.png (and signals.png for --signal) into this directory");
       app.add_option("--bitrate", o->bitrate, "Nominal bus bit rate for the bus load, bit/s (default 500000)");
       app.add_option("--data-bitrate", o->data_bitrate, "CAN FD data-phase bit rate, bit/s (default 2000000)");
       app.add_option("--imu-protocol", o->imu_protocol,
@@ -157,7 +158,7 @@ const CommandRegistration registration{
           ->check(CLI::Range(1.0, 100000.0));
       app.add_option("--dbc", o->dbc_files,
                      "DBC file(s) describing other frames on the bus: every signal is decoded and reported "
-                     "(range, rate, values outside the DBC's range, rate against GenMsgCycleTime); repeatable");
+                     "(range, rate, values outside the DBC's range, period against GenMsgCycleTime)");
       app.add_option("--signal", o->signals, "MESSAGE.SIGNAL of a DBC to plot against time (repeatable)");
       app.add_option("--signal-plot", o->signal_plot, "PNG for the --signal plot (default: signals.png in --plot DIR)");
       app.add_option("--csv", o->csv,

@@ -50,8 +50,6 @@ std::string shown(std::string_view rest) {
   return out.empty() ? (rest.empty() ? "the end" : "a blank") : "'" + out + "'";
 }
 
-// A DBC string as UTF-8 on one line: files from Windows tools are often Latin-1 / cp1252
-// ("°C" as one byte 0xB0), which is re-encoded; control characters become '?'.
 // Well-formed UTF-8 as RFC 3629 has it (no overlong forms, surrogates or code points past
 // U+10FFFF), which JSON writers insist on.
 bool valid_utf8(std::string_view s) {
@@ -75,6 +73,10 @@ bool valid_utf8(std::string_view s) {
   }
   return true;
 }
+
+// A DBC string as UTF-8 on one line: files from Windows tools are often Latin-1 ("°C" as the
+// one byte 0xB0), which is re-encoded when the string is not UTF-8; control characters
+// become '?'.
 std::string text_of(std::string_view raw) {
   const bool utf8 = valid_utf8(raw);
   std::string out;
