@@ -110,6 +110,15 @@ make_inputs() {
   head -c 3000 "$teabox/video.mp4" > can_garbled.log
   printf '(1.000000) can0 123#00\n  can0  123  [12]  remote request\n(1.000100) can0 123#R8_\n' > can_impossible.log
   { printf '(1.000000) can0 123#'; head -c 10000 /dev/zero | tr '\0' 'A'; printf '\n(1.000100) can0 124#00\n'; } > can_long.log
+  # DBC files (replay --dbc)
+  put dbc_ok.dbc 'BO_ 256 M: 8 N\n SG_ a : 0|8@1+ (1,0) [0|0] "" N\n'
+  put dbc_truncated.dbc 'BO_ 256 M: 8 N\n SG_ a : 0|8@1+ (1,0) [0|'
+  put dbc_order.dbc 'BO_ 256 M: 8 N\n SG_ a : 0|8@2+ (1,0) [0|0] "" N\n'
+  put dbc_beyond.dbc 'BO_ 256 M: 8 N\n SG_ a : 60|8@1+ (1,0) [0|0] "" N\n'
+  put dbc_beyond_fd.dbc 'BO_ 256 M: 64 N\n SG_ a : 508|8@1+ (1,0) [0|0] "" N\n'
+  put dbc_unclosed.dbc 'BO_ 256 M: 8 N\n SG_ a : 0|8@1+ (1,0) [0|0] "" N\nCM_ SG_ 256 a "no end;\n'
+  put dbc_nomux.dbc 'BO_ 256 M: 8 N\n SG_ a m1 : 0|8@1+ (1,0) [0|0] "" N\n'
+  head -c 3000 "$teabox/video.mp4" > dbc_garbled.dbc
   # scenarios and run configurations
   put scn_garbage.scn 'this is not a scenario\n\377\376\n'
   put scn_nan.scn 'scene can\nframes nan\nfps 30\n'
@@ -209,6 +218,15 @@ O="--out out --no-video --every 0 --frames 2"
   run 1 "replay: garbled log (video bytes)" replay can_garbled.log
   run 0 "replay: FD remote frame, DLC '_' with no digit" replay can_impossible.log
   run 0 "replay: a 10 kB line" replay can_long.log
+  run 1 "replay --dbc: DBC missing" replay can_truncated.log --dbc no_such.dbc
+  run 1 "replay --dbc: SG_ line cut short" replay can_truncated.log --dbc dbc_truncated.dbc
+  run 1 "replay --dbc: byte order '@2'" replay can_truncated.log --dbc dbc_order.dbc
+  run 0 "replay --dbc: signal beyond its 8-byte message" replay can_truncated.log --dbc dbc_beyond.dbc
+  run 1 "replay --dbc: signal beyond any CAN FD frame" replay can_truncated.log --dbc dbc_beyond_fd.dbc
+  run 1 "replay --dbc: comment never closed" replay can_truncated.log --dbc dbc_unclosed.dbc
+  run 1 "replay --dbc: multiplexed signal, no multiplexor" replay can_truncated.log --dbc dbc_nomux.dbc
+  run 1 "replay --dbc: garbled DBC (video bytes)" replay can_truncated.log --dbc dbc_garbled.dbc
+  run 1 "replay --dbc: unknown --signal" replay can_truncated.log --dbc dbc_ok.dbc --signal M.b --plot out
   run 1 "sim: unknown scenario name" sim no_such_scenario --out out
   run 1 "sim: .scn garbage" sim scn_garbage.scn --out out
   run 1 "sim: .scn frames nan" sim scn_nan.scn --out out

@@ -198,9 +198,31 @@ def template_cache(out):
     write(out, "template_cache", "truncated", cache(7, [r1])[:-5])
 
 
+def dbc(out):
+    # The real databases whole (ours and the third-party one), each with a frame to decode,
+    # and small ones for what neither has: FD, signed Motorola, floats, VAL_, cycle times.
+    frame = b"\n@@frame@@\n"
+    ours = (ROOT / "firmware_iface/epichead.dbc").read_bytes()
+    anzen = (SHARED / "can/canbus_visualizer_anzen.dbc").read_bytes()
+    write(out, "dbc", "epichead", ours + frame + bytes([0x13, 0x10, 0x27, 0xF0, 0xD8, 0x14, 0x00, 0x00]))
+    write(out, "dbc", "anzen", anzen + frame + bytes.fromhex("4139E9391A444540") + frame + bytes.fromhex("0101020304050607"))
+    small = ('VERSION ""\n\nNS_ :\n\tCM_\n\tBA_\n\nBS_:\n\nBU_: N\n\n'
+             'BO_ 2147483905 Fd: 64 N\n SG_ sel M : 0|8@1+ (1,0) [0|3] "" N\n'
+             ' SG_ a m1 : 7|12@0- (0.5,1) [-1000|1000] "x" N\n SG_ f m2 : 32|32@1- (2,0) [0|0] "" N\n'
+             ' SG_ last : 504|8@1+ (1,0) [0|0] "\xb0C" N\n\n'
+             'BO_ 3221225472 VECTOR__INDEPENDENT_SIG_MSG: 0 Vector__XXX\n SG_ o : 0|8@1+ (1,0) [0|0] "" X\n\n'
+             'CM_ BO_ 2147483905 "a; b\nc";\nBA_DEF_DEF_ "GenMsgCycleTime" 50;\n'
+             'BA_ "GenMsgCycleTime" BO_ 2147483905 10;\nVAL_ 2147483905 sel 0 "Off" 1 "On" ;\n'
+             'SIG_VALTYPE_ 2147483905 f : 1;\n').encode("latin-1")
+    write(out, "dbc", "small_fd", small + frame + bytes(range(64)) + frame + bytes([2, 0, 0, 0, 0, 0, 0xC0, 0x3F]))
+    write(out, "dbc", "truncated_sg", b'BO_ 256 M: 8 N\n SG_ a : 0|8@1+ (1,0) [0|')
+    write(out, "dbc", "bad_order", b'BO_ 256 M: 8 N\n SG_ a : 0|8@2+ (1,0) [0|0] "" N\n')
+    write(out, "dbc", "beyond_frame", b'BO_ 256 M: 8 N\n SG_ a : 60|8@1+ (1,0) [0|0] "" N\n' + frame + bytes(9))
+
+
 def main():
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "build-fuzz" / "seeds"
-    for make in (cao, camera, csvs, candump, can_protocol, dronecan, hid, scenario, run_config, template_cache):
+    for make in (cao, camera, csvs, candump, can_protocol, dronecan, hid, scenario, run_config, template_cache, dbc):
         make(out)
 
 

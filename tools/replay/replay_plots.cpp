@@ -4,6 +4,7 @@
 
 #include "epichead/firmware_iface/can_ids.h"
 #include "plot/line_plot.h"
+#include "replay/dbc_analysis.h"
 #include "replay/onboard_replay.h"
 
 namespace epichead::tools::replay {
@@ -113,6 +114,27 @@ std::expected<void, std::string> write_attitude_plot(const OnboardReplay& r, con
               {"pitch (optical axis up)", t, s.column(1)},
               {"yaw (optical axis right)", t, s.column(2)}};
   return plot::write_png({title + ": attitude", {p}}, (std::filesystem::path(dir) / "attitude.png").string());
+}
+
+std::expected<void, std::string> write_signal_plot(const DbcAnalyzer& a, const std::string& path,
+                                                   const std::string& title, double t0_s) {
+  plot::Figure figure{title + ": DBC signals", {}};
+  for (const auto& p : a.plotted()) {
+    if (p.series.empty()) continue;
+    plot::Panel panel{p.name, "time since start [s]", p.unit.empty() ? "value" : p.unit, {}};
+    panel.series.push_back({p.name, relative(p.series.t(), t0_s), p.series.column(0)});
+    figure.panels.push_back(std::move(panel));
+  }
+  if (figure.panels.empty()) {
+    std::string names;
+    for (const auto& p : a.plotted()) names += (names.empty() ? "" : ", ") + p.name;
+    return std::unexpected(path + ": nothing to plot: no time-stamped frame in the log carries " + names);
+  }
+  const auto dir = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (ec) return std::unexpected(dir.string() + ": cannot create directory (" + ec.message() + ")");
+  return plot::write_png(figure, path);
 }
 
 }  // namespace epichead::tools::replay
