@@ -1,4 +1,5 @@
 #include "replay/dbc_analysis.h"
+#include "report_format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,12 +12,6 @@ namespace fw = firmware_iface;
 namespace {
 
 std::uint64_t key_of(std::uint32_t id, bool extended) { return id | (std::uint64_t{extended} << 32); }
-
-std::string hex_id(std::uint32_t id, bool extended) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, extended ? "0x%08X" : "0x%03X", id);
-  return buf;
-}
 
 // "MESSAGE.SIGNAL" split at its first dot.
 std::pair<std::string_view, std::string_view> split_name(std::string_view full) {

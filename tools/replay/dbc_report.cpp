@@ -1,4 +1,5 @@
 #include "replay/dbc_report.h"
+#include "report_format.h"
 
 #include <cmath>
 #include <cstdio>
@@ -13,18 +14,7 @@ namespace {
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-std::string hex_id(std::uint32_t id, bool extended) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, extended ? "0x%08X" : "0x%03X", id);
-  return buf;
-}
-
-std::string fmt(double v, const char* f = "%.6g") {
-  if (!std::isfinite(v)) return "-";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
+std::string fmt(double v, const char* f = "%.6g") { return format_number(v, f); }
 
 std::string range_text(const fw::DbcSignal& s) {
   if (!s.has_range()) return "-";

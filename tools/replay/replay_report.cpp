@@ -1,4 +1,5 @@
 #include "replay/replay_report.h"
+#include "report_format.h"
 
 #include <cmath>
 #include <cstdio>
@@ -31,18 +32,7 @@ json timing_json(const StreamStats& s, double log_span_s) {
   return j;
 }
 
-std::string hex_id(std::uint32_t id, bool extended) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, extended ? "0x%08X" : "0x%03X", id);
-  return buf;
-}
-
-std::string fmt(double v, const char* f = "%.1f") {
-  if (!std::isfinite(v)) return "-";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
+std::string fmt(double v, const char* f = "%.1f") { return format_number(v, f); }
 
 std::string gap_text(const GapStats& g) {
   if (g.count() == 0) return "-";
