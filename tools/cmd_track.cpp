@@ -49,6 +49,7 @@ struct TrackArgs {
   std::string imu_time_offset = "auto";
   std::string free_turn = "auto";
   bool settle = true;
+  bool outline_colours = true;
   std::uint32_t ransac_seed = RansacOptions{}.seed;
   AcquisitionOptions acquisition;
 };
@@ -245,6 +246,7 @@ ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
   options.lines.epic.ransac.seed = args.ransac_seed;
   options.free_turn_of_revolution = args.free_turn == "auto";
   options.settle = args.settle;
+  options.outline_colours = args.outline_colours;
   return options;
 }
 
@@ -455,6 +457,9 @@ const CommandRegistration registration{
       app.add_flag("!--no-settle", a->settle,
                    "Measure the first frame (and the first after a loss) from the start pose only, without the "
                    "gradient pass that settles the start before the cue references are learnt");
+      app.add_flag("!--no-outline-colours", a->outline_colours,
+                   "On those frames, do not weigh outline edges by the object's and the background's colours "
+                   "(learnt from the model drawn at the start pose; they tell a rim from a printed border inside it)");
       app.add_option("--ransac-seed", a->ransac_seed,
                      "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");
       app.add_flag("!--no-reacquire", a->acquisition.reacquire,

@@ -1,4 +1,5 @@
 #include "epichead/vision/ellipse_tracker.h"
+#include "epichead/vision/object_region.h"
 
 #include <algorithm>
 #include <climits>
@@ -48,6 +49,7 @@ EllipseTracker::EllipseTracker(const EllipseTrackerOptions& options)
   const int max_points = window_options(options_).max_rows * (window_options(options_).width_px / 2 + 1);
   px_x_.resize(static_cast<std::size_t>(max_points));
   px_y_.resize(static_cast<std::size_t>(max_points));
+  outer_side_.reserve(static_cast<std::size_t>(options_.lines) + 2);
   px_row_.resize(static_cast<std::size_t>(max_points));
 }
 
@@ -149,7 +151,13 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
     return;
   }
   f.visible = true;
-  detector_.detect(window_.window(), f.side, f.refs, options_.mode, f.result);
+  OutlineEvidence outline;
+  if (outline_region_ && outline_region_->ready()) {
+    outer_side_.resize(f.lines.size());  // within the reserved capacity
+    for (std::size_t r = 0; r < f.lines.size(); ++r) outer_side_[r] = outline_region_->outer_side(f.lines[r].centre_px, f.lines[r].normal);
+    outline = {outline_region_, outer_side_.data()};
+  }
+  detector_.detect(window_.window(), f.side, f.refs, options_.mode, f.result, false, outline);
   fit(f);
   update_arc(f);
   if (f.found && options_.mode != EpicMode::Gradient) {

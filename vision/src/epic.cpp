@@ -1,4 +1,5 @@
 #include "epichead/vision/epic.h"
+#include "epichead/vision/object_region.h"
 
 #include <algorithm>
 #include <cmath>
@@ -85,7 +86,7 @@ void EpicDetector::init_references(const LineWindow& window, ObjectSide side, Fe
 }
 
 void EpicDetector::detect(const LineWindow& window, ObjectSide side, const FeatureReferences& refs,
-                          EpicMode mode, EpicResult& out, bool look_through) {
+                          EpicMode mode, EpicResult& out, bool look_through, const OutlineEvidence& outline) {
   out.geometry = window.geometry();
   out.look_through = look_through && mode != EpicMode::Gradient;
   out.intervals.clear();
@@ -101,8 +102,10 @@ void EpicDetector::detect(const LineWindow& window, ObjectSide side, const Featu
     return;
   }
   histograms_.prepare(window);
-  histograms_.intervals(window, out.edgels, out.intervals, weight_left(side) > 0, weight_right(side) > 0);
+  const bool weigh = outline.active();
+  histograms_.intervals(window, out.edgels, out.intervals, weigh || weight_left(side) > 0, weigh || weight_right(side) > 0);
   likelihoods(out, side, refs, window.colour());
+  if (weigh) weigh_outline(out, outline);
   select_good_epic(out);
   fit(out, mode == EpicMode::EpicSingle ? 1 : options_.ransac.max_candidates);
 }
@@ -128,6 +131,18 @@ void EpicDetector::likelihoods(EpicResult& out, ObjectSide side, const FeatureRe
     for (int i = 0; i < n; ++i) set.edgels[i].likelihood = agreement(agree_left_, i, 0) * inv_w;
   else
     for (int i = 0; i < n; ++i) set.edgels[i].likelihood = agreement(agree_right_, i, 1) * inv_w;
+}
+
+void EpicDetector::weigh_outline(EpicResult& out, const OutlineEvidence& outline) const {
+  EdgelSet& set = out.edgels;
+  const int n = static_cast<int>(set.edgels.size());
+  for (int i = 0; i < n; ++i) {
+    Edgel& e = set.edgels[static_cast<std::size_t>(i)];
+    const std::int8_t outer = outline.outer_side[e.row];
+    if (outer == 0) continue;
+    const IntervalCues& beyond = out.intervals[static_cast<std::size_t>(side_interval(set, out.intervals, i, outer > 0 ? 1 : 0, out.look_through))];
+    e.likelihood *= 1.0f - outline.region->object_probability(beyond);
+  }
 }
 
 void EpicDetector::select_good_epic(EpicResult& out) const {

@@ -1,4 +1,5 @@
 #include "epichead/vision/line_tracker.h"
+#include "epichead/vision/object_region.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,9 @@
 namespace epichead::vision {
 
 LineTracker::LineTracker(const LineTrackerOptions& options)
-    : options_(options), window_(options.window), detector_(options.epic, options.window) {}
+    : options_(options), window_(options.window), detector_(options.epic, options.window) {
+  outer_side_.reserve(static_cast<std::size_t>(std::max(options.window.max_rows, 2)));
+}
 
 void LineTracker::reset() {
   for (LineFeature& f : features_) {
@@ -102,7 +105,15 @@ void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece,
     return;
   }
   f.visible = true;
-  detector_.detect(window_, piece.side, f.refs, options_.mode, f.result, look_through);
+  OutlineEvidence outline;
+  if (outline_region_ && outline_region_->ready()) {
+    const WindowGeometry& g = window_.geometry();
+    outer_side_.resize(static_cast<std::size_t>(g.rows));  // within the reserved capacity
+    for (int r = 0; r < g.rows; ++r)
+      outer_side_[static_cast<std::size_t>(r)] = outline_region_->outer_side(g.to_image(0, g.s_of_row(r)), g.across);
+    outline = {outline_region_, outer_side_.data()};
+  }
+  detector_.detect(window_, piece.side, f.refs, options_.mode, f.result, look_through, outline);
   // Candidates are sorted by support: drop the tail too weak to be a line of this window.
   const int rows = window_.geometry().rows;
   const int need = std::max(options_.epic.ransac.min_support,

@@ -78,7 +78,8 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
       lines_(line_options(options)),
       ellipses_(ellipse_options(options)),
       validator_(model, options.validation),
-      estimator_(camera, options.pose) {
+      estimator_(camera, options.pose),
+      region_(options.outline) {
   const std::size_t edges = model.edges.size();
   // One pose-problem slot per model edge, kept for the tracker's life: a slot's edgel buffer
   // keeps its capacity, and unused slots (no edgels) are ignored by the estimator. A slot's
@@ -327,12 +328,22 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   out = FrameReport{};
   out.cam_T_obj = predicted;
   StageTimes settling;
+  if (!settled_ && options_.outline_colours && options_.mode != TrackMode::Gradient) {
+    const auto t = Clock::now();
+    if (region_.learn(image, *model_, camera_, predicted)) {
+      lines_.set_outline(&region_);
+      ellipses_.set_outline(&region_);
+    }
+    settling.epic_ms += ms_since(t);
+  }
   const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling);
   bool pose_ok = measure(image, start, out);
   out.times.add_stages(settling);
   if (!pose_ok && fallback) {
     // The second opinion: measured afresh from the other prediction (measure() learns nothing,
     // so the first attempt leaves no trace but its stage times, which add up).
+    lines_.set_outline(nullptr);  // the region was drawn at the other prediction
+    ellipses_.set_outline(nullptr);
     const StageTimes first = out.times;
     const int iterations = out.pose_iterations;
     out = FrameReport{};
@@ -343,6 +354,8 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
     out.used_fallback = true;
     if (!pose_ok) out.cam_T_obj = predicted;
   }
+  lines_.set_outline(nullptr);
+  ellipses_.set_outline(nullptr);
   const auto& features = lines_.features();
   TrackReason reasons = out.reasons;
   if (!pose_ok) {

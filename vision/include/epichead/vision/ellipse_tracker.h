@@ -81,6 +81,8 @@ class EllipseTracker {
   explicit EllipseTracker(const EllipseTrackerOptions& options = {});
   const EllipseTrackerOptions& options() const { return options_; }
   void set_mode(EpicMode mode) { options_.mode = mode; }
+  // As LineTracker::set_outline: the object's region weighs the rims' outline edgels.
+  void set_outline(const ObjectRegion* region) { outline_region_ = region; }
 
   // Tracks one frame: every ellipse of `visible` (references initialised from the projection
   // the first time a circle is seen).
@@ -111,6 +113,8 @@ class EllipseTracker {
   EllipseRansac ransac_;
   std::vector<EllipseFeature> features_;
   std::vector<double> px_x_, px_y_;  // scratch: good edgels in the image
+  const ObjectRegion* outline_region_ = nullptr;
+  std::vector<std::int8_t> outer_side_;  // per tracker line, while outline_region_ is set
   std::vector<int> px_row_;
   LineCandidate update_;             // scratch: the selected ellipse's inliers as an EPIC candidate
 };

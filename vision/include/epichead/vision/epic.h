@@ -3,6 +3,7 @@
 // cues, the likelihood of each edgel against the feature's reference, the good edgels, RANSAC
 // candidates, and the update of the reference from the selected candidate. See docs/epic.md.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -46,6 +47,18 @@ struct EpicOptions {
   float init_margin_px = 3.0f;
 };
 
+class ObjectRegion;
+
+// What the object's region (object_region.h) says about one window: per window row, the side
+// that leaves the object there (+1 the high columns, -1 the low ones, 0 not on the outline).
+// On outline rows an edgel whose interval on that side looks like the object is unlikely to be
+// the object's edge, however well its object side agrees with the references.
+struct OutlineEvidence {
+  const ObjectRegion* region = nullptr;
+  const std::int8_t* outer_side = nullptr;
+  bool active() const { return region != nullptr && outer_side != nullptr; }
+};
+
 // A candidate line of one window, in window and image coordinates.
 struct LineCandidate {
   WindowLine line;                             // x = m s + c in the window
@@ -87,8 +100,10 @@ class EpicDetector {
   // edgel's cue on that side is the interval beyond the neighbour, instead of no evidence. For
   // an edge with no other model edge close and parallel to it (the caller knows the model); two
   // close parallel edges would otherwise look alike and no longer be told apart.
+  // outline: weighs each outline row's edgels by how little their outer interval looks like the
+  // object (EPIC modes; the outer intervals are then computed too).
   void detect(const LineWindow& window, ObjectSide side, const FeatureReferences& refs,
-              EpicMode mode, EpicResult& out, bool look_through = false);
+              EpicMode mode, EpicResult& out, bool look_through = false, const OutlineEvidence& outline = {});
   // Re-estimates the object-side references from the interval cues of the candidate's inlier
   // edgels (exponential forgetting, sigma floored). No-op with fewer than 3 valid intervals.
   void update_references(const EpicResult& result, const LineCandidate& selected, ObjectSide side,
@@ -96,6 +111,7 @@ class EpicDetector {
 
  private:
   void likelihoods(EpicResult& out, ObjectSide side, const FeatureReferences& refs, bool colour);
+  void weigh_outline(EpicResult& out, const OutlineEvidence& outline) const;
   void select_good_epic(EpicResult& out) const;
   void select_good_gradient(EpicResult& out) const;
   void fit(EpicResult& out, int max_candidates);

@@ -67,6 +67,9 @@ class LineTracker {
   explicit LineTracker(const LineTrackerOptions& options = {});
   const LineTrackerOptions& options() const { return options_; }
   void set_mode(EpicMode mode) { options_.mode = mode; }
+  // The object's region to weigh outline edgels with (EpicDetector::detect's OutlineEvidence),
+  // or nullptr (the default): not owned, must outlive the detect() calls it is set for.
+  void set_outline(const ObjectRegion* region) { outline_region_ = region; }
 
   // Tracks one frame. Each model edge uses its longest visible piece in `visible` (the
   // projection and the ObjectSide); references are initialised from the projection the first
@@ -96,6 +99,8 @@ class LineTracker {
   EpicDetector detector_;
   std::vector<LineFeature> features_;
   std::vector<int> longest_;  // per edge: index of its longest visible piece this frame
+  const ObjectRegion* outline_region_ = nullptr;
+  std::vector<std::int8_t> outer_side_;  // per window row, while outline_region_ is set
 };
 
 }  // namespace epichead::vision

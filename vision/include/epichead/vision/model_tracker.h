@@ -17,6 +17,7 @@
 #include "epichead/vision/cao_model.h"
 #include "epichead/vision/ellipse_tracker.h"
 #include "epichead/vision/line_tracker.h"
+#include "epichead/vision/object_region.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/rim_side.h"
 #include "epichead/vision/topology_validator.h"
@@ -86,6 +87,12 @@ struct ModelTrackerOptions {
   // The first frame (and the first after a reset or a loss) is measured from the start pose
   // and from a gradient pass's pose, and the better supported start kept (settle()).
   bool settle = true;
+  // On those frames, whose cue references come only from the start pose, the model drawn at
+  // the start gives object and background colours (object_region.h), and edgels on the outline
+  // whose far side looks like the object weigh little: the references cannot yet tell a rim
+  // from a printed border just inside it (a can's label), but the colours beyond them can.
+  bool outline_colours = true;
+  ObjectRegionOptions outline;
 };
 
 // Per-stage wall time of one frame, milliseconds.
@@ -170,6 +177,7 @@ class ModelTracker {
   TopologyValidator validator_;
   PoseEstimator estimator_;
   VisibleModel visible_;
+  ObjectRegion region_;  // learnt on the frames that settle (outline_colours)
   ValidationResult validation_;
   PoseProblem problem_;
   PoseResult pose_;
