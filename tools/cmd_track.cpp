@@ -252,6 +252,7 @@ ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
 
 // IMU samples the predictor could not use are counted in report.json; say so where it is seen.
 void warn_dropped_imu(const nlohmann::json& predictor) {
+  if (!predictor.is_object()) return;  // null: the object was never found, so nothing was predicted
   const std::uint64_t rejected = predictor.value("imu_rejected", std::uint64_t{0});
   if (rejected == 0) return;
   std::fprintf(stderr, "track: %llu IMU samples dropped (%llu saturated or beyond any sensor's range); report.json: predictor\n",

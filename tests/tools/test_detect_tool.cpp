@@ -120,6 +120,26 @@ TEST_CASE("track without init.csv detects the tea box and follows the real teabo
   CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
 }
 
+TEST_CASE("track without init.csv on frames without the object reports every frame searched and exits cleanly") {
+  // The object never found: no pose, so no predictor; the report says so instead of failing.
+  TempDir tmp("epichead_test_track_never_found");
+  const std::string seq = tmp / "empty", out = tmp / "track";
+  fs::create_directories(seq + "/frames");
+  fs::copy_file(kTeabox + "/camera.yaml", seq + "/camera.yaml");
+  fs::copy_file(kTeabox + "/model.cao", seq + "/model.cao");
+  std::ofstream(seq + "/frames.csv") << "frame,t_s,file\n0,0.0,frames/0.pgm\n1,0.033,frames/1.pgm\n";
+  for (const char* name : {"/frames/0.pgm", "/frames/1.pgm"}) {
+    std::ofstream pgm(seq + name, std::ios::binary);
+    pgm << "P5 640 480 255\n" << std::string(640 * 480, static_cast<char>(128));  // a grey wall
+  }
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video" + kCache);
+  INFO(run.out << run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  CHECK(report["searched_frames"] == 2);
+  CHECK(report["predictor"].is_null());
+}
+
 TEST_CASE("track finds the package again after a board hides it for a second (box_cover), and counts it, and gravity narrows detection") {
   TempDir tmp("epichead_test_track_cover");
   const std::string seq = tmp / "box_cover", out = tmp / "track";
