@@ -88,3 +88,21 @@ TEST_CASE("sim-run --soak: the closed run alone, with memory and the predictor's
   CHECK_FALSE(std::filesystem::exists(dir / "out/bus.log"));
   CHECK_FALSE(std::filesystem::exists(dir / "out/timeline.csv"));
 }
+
+TEST_CASE("sim-run leaves the frames a cover board hides the object in out of the tracking success, as score does",
+          "[tools][sim-run]") {
+  TempDir dir("sim_run_cover");
+  const std::string scn = dir.write("cover.scn", slurp(std::string(EPICHEAD_SOURCE_DIR) + "/sim/scenarios/mockup_walk.scn") +
+                                                     "cover 1.0 0.5\n");
+  const auto r = run_epichead(dir, "sim-run '" + scn + "' --out '" + dir.str() + "/out' --seconds 2 --downscale 4 --every 0");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  INFO(j.dump());
+  // 0.5 s at the scenario's frame rate, give or take a frame at either end.
+  const int hidden = j["hidden_frames"].get<int>();
+  CHECK(hidden >= 12);
+  CHECK(hidden <= 17);
+  CHECK(j["frames"].get<int>() > 20);
+  CHECK(r.out.find("frames with the object hidden by a cover left out") != std::string::npos);
+}
