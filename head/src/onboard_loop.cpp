@@ -346,8 +346,11 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
   controller->request(options.mode);
   if (const char* why = fw::candump_iface_problem(options.candump_iface))
     return std::unexpected("onboard loop: CAN interface name '" + options.candump_iface + "' cannot be recorded: it " + why);
+  Recorder::ClockPairSource log_clocks = hw::read_clock_pair;
+  if (ports.simulated) log_clocks = [epoch_us = options.simulated_log_epoch_unix_us] { return hw::ClockPair{0, epoch_us}; };
   auto recorder = Recorder::open(options.candump_path, options.candump_iface, options.diagnostics_path,
-                                 options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline);
+                                 options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline,
+                                 std::move(log_clocks));
   if (!recorder) return std::unexpected("onboard loop: " + recorder.error());
   auto impl = std::make_unique<Impl>(model, camera, options, ports, std::move(*predictor), std::move(*controller),
                                      std::move(*recorder));
