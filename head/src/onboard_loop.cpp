@@ -283,8 +283,12 @@ struct OnboardLoop::Impl {
 
   void tick(double now_s, const FrameHook& hook) {
     const auto t0 = WallClock::now();
-    if (now_s >= next_sync_s) {
-      next_sync_s = now_s + options.time_sync_period_s;
+    // On a grid of time_sync_period_s, with half a tick of slack: a clock that reads a hair before
+    // the due tick (rounding, the simulator's integer clock) would otherwise send one tick late,
+    // every time (101 ms instead of 100). After a stall the grid starts again from now.
+    if (now_s >= next_sync_s - 0.5 / options.control_rate_hz) {
+      next_sync_s += options.time_sync_period_s;
+      if (next_sync_s <= now_s) next_sync_s = now_s + options.time_sync_period_s;
       if (auto frame = fw::encode(imu_clock.make_request(now_s))) send(frame->frame, now_s);
     }
     drain_bus(now_s);
