@@ -38,7 +38,7 @@ struct Options {
   std::string log;
   bool json = false;
   std::string plot_dir;
-  double bitrate = 500'000;
+  double bitrate = 1'000'000;  // the protocol's bit rate (docs/protocol.md)
   double data_bitrate = 2'000'000;
   std::string imu_protocol = "auto";
   double imu_rate_hz = 1000;
@@ -150,7 +150,8 @@ const CommandRegistration registration{
       app.add_option("LOG", o->log, "candump log (candump -l format, or candump's default output)")->required();
       app.add_flag("--json", o->json, "Print one JSON object instead of the text report");
       app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png and attitude.png (and signals.png for --signal) into this directory");
-      app.add_option("--bitrate", o->bitrate, "Nominal bus bit rate for the bus load, bit/s (default 500000)");
+      app.add_option("--bitrate", o->bitrate, "Nominal bus bit rate for the bus load, bit/s (default 1000000, the bit rate docs/protocol.md "
+                     "states for the robot's bus)");
       app.add_option("--data-bitrate", o->data_bitrate, "CAN FD data-phase bit rate, bit/s (default 2000000)");
       app.add_option("--imu-protocol", o->imu_protocol,
                      "IMU stream to plot and feed to fusion: epichead, dronecan or auto (both; default)");

@@ -1,6 +1,8 @@
 // `epichead run --config FILE [--seconds S]`: the onboard loop on real devices: a V4L2 camera, a
 // SocketCAN bus carrying the IMU and the head, the monotonic clock. The configuration's keys are
-// described in run_config.h.
+// described in run_config.h. Writes OUT/bus.log (candump, stamped on the wall clock like candump's
+// so that the two merge), OUT/diagnostics.jsonl (the monotonic clock; its first line, clock_map,
+// maps one onto the other) and OUT/summary.json.
 #include <CLI/CLI.hpp>
 
 #include <time.h>
@@ -74,7 +76,9 @@ int run_onboard(const std::string& config_path, double seconds) {
   hw::MonotonicClock clock;
   head::OnboardPorts ports;
   ports.clock = &clock;
-  // SocketCAN stamps with the wall clock, the loop runs on the monotonic one (monotonic_stamped_bus.h).
+  // SocketCAN stamps with the wall clock, the loop runs on the monotonic one (monotonic_stamped_bus.h);
+  // the recorder's writer maps the loop's stamps back onto the wall clock for bus.log, as candump
+  // stamps (head/log_clock.h: one clock pair, steps of the wall clock followed forward only).
   hw::MonotonicStampedBus monotonic_bus(**bus);
   ports.bus = &monotonic_bus;
   ports.camera = camera->get();

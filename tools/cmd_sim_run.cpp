@@ -1,8 +1,9 @@
 // `epichead sim-run SCENARIO --out DIR [--seconds S] [--mode fixate|stabilise|hold] ...`: the
 // onboard loop, closed loop against the simulator's camera, IMU, bus and head (hardware in the
 // loop, simulated time), then the same body motion with the head held fixed for comparison.
-// Prints a summary and writes DIR/summary.json, DIR/bus.log (candump; `epichead replay` reads
-// it), DIR/diagnostics.jsonl, DIR/timeline.csv (the truth every millisecond: what the head
+// Prints a summary and writes DIR/summary.json, DIR/bus.log (candump, stamped on the Unix epoch
+// like candump's with simulated time 0 at --log-epoch; `epichead replay` reads it),
+// DIR/diagnostics.jsonl, DIR/timeline.csv (the truth every millisecond: what the head
 // really did, for tuning and for finding where a residual camera rate comes from),
 // DIR/overlay_NNNNNN.png and DIR/*.png plots. With --soak: only the closed run, for a long
 // time, with memory and the predictor's attitude error watched (no bus log, timeline or plots,
@@ -13,8 +14,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <expected>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -59,7 +63,23 @@ struct SimRunArgs {
   bool no_init = false;    // no start pose: detection finds the object
   bool reacquire = false;  // detection after a loss (always with no_init)
   DetectionArgs detection;
+  // Where simulated time 0 lands in bus.log (Unix seconds, or "now"): a fixed date by default, so
+  // that the same seed writes the same log; "now" lines a run up with today's logs.
+  std::string log_epoch = std::to_string(head::kSimulatedLogEpochUnix_us / 1'000'000);
+  std::int64_t log_epoch_unix_us = head::kSimulatedLogEpochUnix_us;  // log_epoch, read
 };
+
+// --log-epoch: whole or fractional Unix seconds from 0 to 10^11 (a candump stamp has at most 12
+// digits of seconds, and the run must fit after it), or "now".
+std::expected<std::int64_t, std::string> parse_log_epoch(const std::string& text) {
+  if (text == "now")
+    return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  char* end = nullptr;
+  const double s = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !(s >= 0 && s <= 1e11))
+    return std::unexpected("--log-epoch must be Unix seconds from 0 to 1e11 or 'now', got '" + text + "'");
+  return std::llround(s * 1e6);
+}
 
 // What one closed run measured against the simulator's truth.
 struct RunMeasures {
@@ -237,6 +257,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   o.processing_s = a.processing_ms * 1e-3;
   const bool wall = a.threads == "wall";
   if (wall) o.threads = head::VisionThreads::Thread;  // processing_s is then what tracking really takes
+  o.simulated_log_epoch_unix_us = a.log_epoch_unix_us;
   if (render) {
     if (!a.soak) o.candump_path = (fs::path(out) / "bus.log").string();
     o.diagnostics_path = (fs::path(out) / "diagnostics.jsonl").string();
@@ -339,8 +360,11 @@ int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::
   return 0;
 }
 
-int run_sim_run(const SimRunArgs& a) {
+int run_sim_run(const SimRunArgs& given) {
   const char* cmd = "sim-run";
+  SimRunArgs a = given;
+  if (auto epoch = parse_log_epoch(a.log_epoch)) a.log_epoch_unix_us = *epoch;
+  else return fail(cmd, epoch.error());
   static const std::map<std::string, head::ControlMode> modes{
       {"fixate", head::ControlMode::Fixate}, {"stabilise", head::ControlMode::Stabilise}, {"hold", head::ControlMode::Hold}};
   const auto mode = modes.find(a.mode);
@@ -478,6 +502,10 @@ const CommandRegistration registration{
       app.add_flag("--no-init", a->no_init,
                    "Give the loop no start pose: detection finds the object (and finds it again after a loss)");
       app.add_flag("--reacquire", a->reacquire, "Detection finds the object again after a loss");
+      app.add_option("--log-epoch", a->log_epoch,
+                     "Unix time (s) at which simulated time 0 is written in bus.log, as candump stamps on the wall "
+                     "clock (default 1704067200, 2024-01-01T00:00:00Z, so a seed gives the same log; 'now': the "
+                     "current time)");
       add_detection_options(app, a->detection);
       app.add_flag("--soak", a->soak,
                    "Soak run: the closed run alone (no comparison runs, bus log, timeline or plots), reporting resident "

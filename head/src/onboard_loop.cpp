@@ -283,8 +283,12 @@ struct OnboardLoop::Impl {
 
   void tick(double now_s, const FrameHook& hook) {
     const auto t0 = WallClock::now();
-    if (now_s >= next_sync_s) {
-      next_sync_s = now_s + options.time_sync_period_s;
+    // On a grid of time_sync_period_s, with half a tick of slack: a clock that reads a hair before
+    // the due tick (rounding, the simulator's integer clock) would otherwise send one tick late,
+    // every time (101 ms instead of 100). After a stall the grid starts again from now.
+    if (now_s >= next_sync_s - 0.5 / options.control_rate_hz) {
+      next_sync_s += options.time_sync_period_s;
+      if (next_sync_s <= now_s) next_sync_s = now_s + options.time_sync_period_s;
       if (auto frame = fw::encode(imu_clock.make_request(now_s))) send(frame->frame, now_s);
     }
     drain_bus(now_s);
@@ -346,8 +350,11 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
   controller->request(options.mode);
   if (const char* why = fw::candump_iface_problem(options.candump_iface))
     return std::unexpected("onboard loop: CAN interface name '" + options.candump_iface + "' cannot be recorded: it " + why);
+  Recorder::ClockPairSource log_clocks = hw::read_clock_pair;
+  if (ports.simulated) log_clocks = [epoch_us = options.simulated_log_epoch_unix_us] { return hw::ClockPair{0, epoch_us}; };
   auto recorder = Recorder::open(options.candump_path, options.candump_iface, options.diagnostics_path,
-                                 options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline);
+                                 options.threads == VisionThreads::Thread ? Recorder::Mode::Thread : Recorder::Mode::Inline,
+                                 std::move(log_clocks));
   if (!recorder) return std::unexpected("onboard loop: " + recorder.error());
   auto impl = std::make_unique<Impl>(model, camera, options, ports, std::move(*predictor), std::move(*controller),
                                      std::move(*recorder));

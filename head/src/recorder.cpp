@@ -1,6 +1,7 @@
 #include "recorder.h"
 
 #include <chrono>
+#include <cinttypes>
 #include <cstring>
 
 namespace epichead::head {
@@ -14,20 +15,35 @@ constexpr std::size_t kLineQueue = 512;
 // The writer sleeps this long when it finds nothing queued: it is no real-time thread, and
 // waking it per record would cost the control thread a system call.
 constexpr auto kWriterIdle = std::chrono::milliseconds(2);
+// How often (log time) the writer re-reads the clock pair, to see a step of the wall clock.
+constexpr std::int64_t kClockReadPeriod_us = 1'000'000;
+
+// Microseconds as seconds with six decimals, printed from the integer so that every digit is exact
+// (as candump prints its stamps).
+int format_seconds(char* out, std::size_t size, std::int64_t us) {
+  const char* sign = us < 0 ? "-" : "";
+  const std::uint64_t mag = us < 0 ? static_cast<std::uint64_t>(-(us + 1)) + 1 : static_cast<std::uint64_t>(us);
+  return std::snprintf(out, size, "%s%" PRIu64 ".%06" PRIu64, sign, mag / 1'000'000, mag % 1'000'000);
+}
 
 }  // namespace
 
 Recorder::Recorder(std::optional<firmware_iface::CandumpWriter> log, std::string iface, std::FILE* diagnostics,
-                   std::string diagnostics_path, Mode mode)
+                   std::string diagnostics_path, Mode mode, ClockPairSource read_clocks)
     : log_(std::move(log)), iface_(std::move(iface)), diagnostics_(diagnostics),
       diagnostics_path_(std::move(diagnostics_path)), mode_(mode), frames_(mode == Mode::Thread ? kFrameQueue : 1),
-      lines_(mode == Mode::Thread ? kLineQueue : 1) {
+      lines_(mode == Mode::Thread ? kLineQueue : 1), read_clocks_(std::move(read_clocks)), log_clock_(read_clocks_()),
+      next_clock_read_us_(log_clock_.pair().monotonic_us + kClockReadPeriod_us) {
+  // Before the writer starts: the mapping is the stream's first line.
+  if (log_) write_clock_map(log_clock_.pair().monotonic_us, nullptr);
   if (mode_ == Mode::Thread) writer_ = std::thread([this] { writer_loop(); });
 }
 
 std::expected<std::unique_ptr<Recorder>, std::string> Recorder::open(const std::string& candump_path,
                                                                      const std::string& iface,
-                                                                     const std::string& diagnostics_path, Mode mode) {
+                                                                     const std::string& diagnostics_path, Mode mode,
+                                                                     ClockPairSource read_clocks) {
+  if (!read_clocks) return std::unexpected("recorder: no clock-pair source for the candump log's wall clock");
   std::optional<firmware_iface::CandumpWriter> log;
   if (!candump_path.empty()) {
     auto w = firmware_iface::CandumpWriter::open(candump_path);
@@ -39,7 +55,8 @@ std::expected<std::unique_ptr<Recorder>, std::string> Recorder::open(const std::
     diagnostics = std::fopen(diagnostics_path.c_str(), "w");
     if (!diagnostics) return std::unexpected("cannot write " + diagnostics_path);
   }
-  return std::unique_ptr<Recorder>(new Recorder(std::move(log), iface, diagnostics, diagnostics_path, mode));
+  return std::unique_ptr<Recorder>(new Recorder(std::move(log), iface, diagnostics, diagnostics_path, mode,
+                                                std::move(read_clocks)));
 }
 
 Recorder::~Recorder() { (void)close(); }
@@ -64,12 +81,42 @@ void Recorder::line(std::string_view text) {
 }
 
 void Recorder::write_frame(const FrameRecord& r) {
-  if (auto ok = log_->write(r.frame, iface_, r.direction); ok) {
+  if (r.frame.stamp_us >= next_clock_read_us_) follow_wall_clock(r.frame.stamp_us);
+  const firmware_iface::StampedCanFrame on_wall_clock{log_clock_.unix_us(r.frame.stamp_us), r.frame.frame};
+  if (auto ok = log_->write(on_wall_clock, iface_, r.direction); ok) {
     frames_logged_.fetch_add(1, std::memory_order_relaxed);
   } else {
     if (first_error_.empty()) first_error_ = ok.error();
     write_errors_.fetch_add(1, std::memory_order_relaxed);
   }
+}
+
+void Recorder::follow_wall_clock(std::int64_t stamp_us) {
+  next_clock_read_us_ = stamp_us + kClockReadPeriod_us;
+  switch (log_clock_.update(read_clocks_())) {
+    case LogClock::Update::Same: return;
+    case LogClock::Update::StepFollowed: return write_clock_map(stamp_us, "true");
+    case LogClock::Update::StepNotFollowed: return write_clock_map(stamp_us, "false");
+  }
+}
+
+void Recorder::write_clock_map(std::int64_t t_us, const char* step_followed) {
+  if (!diagnostics_) return;
+  char t[32], mono[32], unix_s[32], step[32];
+  format_seconds(t, sizeof t, t_us);
+  format_seconds(mono, sizeof mono, log_clock_.pair().monotonic_us);
+  format_seconds(unix_s, sizeof unix_s, log_clock_.pair().unix_us);
+  LineRecord& r = scratch_written_;
+  const int n = step_followed
+                    ? (format_seconds(step, sizeof step, log_clock_.last_step_us()),
+                       std::snprintf(r.text, kMaxLine,
+                                     "{\"t_s\":%s,\"clock_map\":{\"monotonic_s\":%s,\"unix_s\":%s},"
+                                     "\"wall_clock_step_s\":%s,\"step_followed\":%s}",
+                                     t, mono, unix_s, step, step_followed))
+                    : std::snprintf(r.text, kMaxLine, "{\"t_s\":%s,\"clock_map\":{\"monotonic_s\":%s,\"unix_s\":%s}}",
+                                    t, mono, unix_s);
+  r.size = static_cast<std::uint16_t>(n);
+  write_line(r);
 }
 
 void Recorder::write_line(const LineRecord& r) {

@@ -95,7 +95,8 @@ Run run_loop(const std::string& extra, head::ControlMode mode, double seconds) {
     if (rec.frame.frame.id != fw::kIdHeadCommand || rec.direction != fw::CanDirection::Transmitted) continue;
     auto c = fw::decode_head_command(rec.frame.frame);
     REQUIRE(c);
-    r.commands.push_back({rec.frame.stamp_us * 1e-6, *c});
+    // The log is on the Unix epoch, simulated time 0 at the loop's fixed date (log_clock.h).
+    r.commands.push_back({static_cast<double>(rec.frame.stamp_us - o.simulated_log_epoch_unix_us) * 1e-6, *c});
   }
   return r;
 }

@@ -201,6 +201,8 @@ TEST_CASE("The simulated robot's bus keeps the periods epichead.dbc states for i
     ++periodic;
     CHECK(m["cycle_check"] == "ok");
     CHECK(m["late_gaps"] == 0);
+    // The loop's own time sync at exactly its period (docs/protocol.md: 10 Hz), not a tick late.
+    if (m["message"] == "TimeSyncRequest") CHECK(m["median_period_ms"].get<double>() == Approx(100).margin(0.01));
   }
   CHECK(periodic >= 6);  // TimeSyncRequest, HeadCommand, ImuGyro, ImuAccel, HeadState, HeadStatus
 }

@@ -246,7 +246,8 @@ TEST_CASE("Replay of a protocol log written with CandumpWriter reports losses, d
 TEST_CASE("Bus load counts the stuff bits of each classic frame") {
   // 1000 frames 000#, 1 ms apart: SOF, id, RTR, IDE, r0 and DLC are 19 dominant bits and the
   // CRC-15 of all zeros is 0, so 34 dominant bits need 6 stuff bits; with the 13-bit tail a
-  // frame is 53 bits = 106 us at 500 kbit/s, over a span of 0.999 s.
+  // frame is 53 bits = 53 us at the default 1 Mbit/s (docs/protocol.md's), 106 us at 500 kbit/s,
+  // over a span of 0.999 s.
   epichead::testing::TempDir dir;
   std::string text;
   for (int i = 0; i < 1000; ++i) {
@@ -256,9 +257,9 @@ TEST_CASE("Bus load counts the stuff bits of each classic frame") {
   }
   const std::string path = dir.write("zeros.log", text);
   const json j = replay_json(path);
-  CHECK(j["bus_load"].get<double>() == Approx(1000 * 106e-6 / 0.999).epsilon(1e-9));
-  const json j2 = replay_json(path, "--bitrate 1000000");
-  CHECK(j2["bus_load"].get<double>() == Approx(1000 * 53e-6 / 0.999).epsilon(1e-9));
+  CHECK(j["bus_load"].get<double>() == Approx(1000 * 53e-6 / 0.999).epsilon(1e-9));
+  const json j2 = replay_json(path, "--bitrate 500000");
+  CHECK(j2["bus_load"].get<double>() == Approx(1000 * 106e-6 / 0.999).epsilon(1e-9));
 }
 
 TEST_CASE("Replay fails with one line for a missing file, a directory, garbage and bad options") {

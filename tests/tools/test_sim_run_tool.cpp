@@ -3,9 +3,13 @@
 // replay` reads, and rejects bad input with one line.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -49,6 +53,89 @@ TEST_CASE("sim-run: the stabilised camera turns several times slower than with t
   CHECK(counts["HeadCommand"] > 1900);  // one per 1 ms tick once the head state is known
   CHECK(counts["ImuGyro"] > 1900);      // the 1 kHz IMU
   CHECK(counts["HeadState"] > 350);     // 200 Hz
+}
+
+namespace {
+
+// A candump line's stamp in microseconds: "(1704067200.000217) can0 ..." -> 1704067200000217.
+std::int64_t stamp_us(const std::string& line) {
+  const auto dot = line.find('.');
+  return std::stoll(line.substr(1, dot - 1)) * 1'000'000 + std::stoll(line.substr(dot + 1, 6));
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("sim-run: bus.log starts at the fixed epoch 2024-01-01 and merges by time with a candump taken beside it",
+          "[tools][sim-run]") {
+  TempDir dir("sim_run_epoch");
+  const auto r = run_epichead(dir, "sim-run mockup_walk --out '" + dir.str() +
+                                       "/out' --seconds 1 --mode stabilise --downscale 8 --every 0 --settle-s 0");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::vector<std::string> ours = lines_of(slurp(dir / "out/bus.log"));
+  REQUIRE(ours.size() > 3000);
+  CHECK(ours.front().rfind("(1704067200.000000) can0 ", 0) == 0);  // simulated time 0
+  // On the wall clock, in order but for the time-sync request a tick sends before it reads the
+  // frames that came in during the tick before (stamped up to one tick earlier).
+  std::int64_t latest = 0;
+  for (const auto& line : ours) {
+    INFO(line);
+    const std::int64_t t = stamp_us(line);
+    REQUIRE(t > 1'000'000'000'000'000);
+    REQUIRE(t > latest - 1000);
+    latest = std::max(latest, t);
+  }
+  CHECK(latest >= 1'704'067'200'999'000);  // the last tick, 1 s on (or one before it)
+  CHECK(latest <= 1'704'067'201'000'000);
+  // The diagnostics stream keeps simulated time and records the mapping first.
+  CHECK(lines_of(slurp(dir / "out/diagnostics.jsonl")).front() ==
+        "{\"t_s\":0.000000,\"clock_map\":{\"monotonic_s\":0.000000,\"unix_s\":1704067200.000000}}");
+
+  // Another device's candump log over the same second (100 Hz from 0.25 ms), merged by time as
+  // one would merge two candump logs: replay sees one second of bus with both.
+  std::vector<std::string> merged = ours;
+  for (int i = 0; i < 100; ++i) {
+    char line[64];
+    std::snprintf(line, sizeof line, "(1704067200.%06d) can1 3A0#0102030405060708", 250 + i * 10'000);
+    merged.push_back(line);
+  }
+  std::stable_sort(merged.begin(), merged.end(),
+                   [](const std::string& a, const std::string& b) { return stamp_us(a) < stamp_us(b); });
+  std::string text;
+  for (const auto& line : merged) text += line + "\n";
+  const std::string merged_path = dir.write("merged.log", text);
+  const auto replay = run_epichead(dir, "replay '" + merged_path + "' --json");
+  INFO(replay.err);
+  REQUIRE(replay.exit_code == 0);
+  const auto rj = nlohmann::json::parse(replay.out);
+  CHECK(rj["malformed_lines"].get<int>() == 0);
+  CHECK(rj["duration_s"].get<double>() == Approx(1.0).margin(0.0011));  // seconds, not 1.7e9
+  std::map<std::string, nlohmann::json> by_id;
+  for (const auto& id : rj["ids"]) by_id[id["id"].get<std::string>()] = id;
+  REQUIRE(by_id.count("0x3A0") == 1);
+  CHECK(by_id["0x3A0"]["count"].get<int>() == 100);
+  CHECK(by_id["0x3A0"]["rate_hz"].get<double>() == Approx(100).margin(1));
+  CHECK(by_id["0x100"]["rate_hz"].get<double>() == Approx(1000).margin(5));  // HeadCommand, one per tick
+}
+
+TEST_CASE("sim-run --log-epoch sets where simulated time 0 lands in bus.log", "[tools][sim-run]") {
+  TempDir dir("sim_run_log_epoch");
+  const auto r = run_epichead(dir, "sim-run mockup_walk --out '" + dir.str() +
+                                       "/out' --seconds 0.1 --mode stabilise --downscale 8 --every 0 --settle-s 0 "
+                                       "--log-epoch 1436509052.25");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(slurp(dir / "out/bus.log").rfind("(1436509052.250000) can0 ", 0) == 0);
+  const auto bad = run_epichead(dir, "sim-run mockup_walk --out '" + dir.str() + "/o' --log-epoch yesterday");
+  CHECK(bad.exit_code != 0);
+  CHECK(bad.err.find("--log-epoch must be Unix seconds") != std::string::npos);
 }
 
 TEST_CASE("sim-run rejects bad input with one line naming the reason", "[tools][sim-run]") {

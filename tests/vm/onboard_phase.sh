@@ -71,6 +71,7 @@ check() {
 check '.malformed_lines == 0'
 check '.timestamps == "all"'
 check '.duration_s > 0 and .duration_s < 60'   # one time base: sent and received frames on the same clock
+check '.start_s > 1.6e9'                        # on the wall clock, as candump stamps (after 2020)
 check '.error_frames == 0'
 check '.unknown_frames == 0'
 check '[.ids[] | .stamps_backwards // 0] | add == 0'

@@ -29,6 +29,7 @@
 #include "epichead/head/device_clock_sync.h"
 #include "epichead/head/head_controller.h"
 #include "epichead/head/imu_frame_assembler.h"
+#include "epichead/head/log_clock.h"
 #include "epichead/head/realtime_options.h"
 #include "epichead/hw/camera_port.h"
 #include "epichead/hw/can_bus.h"
@@ -45,7 +46,8 @@ struct OnboardPorts {
   // Blocks (robot) or advances simulated time (simulator) until the clock reads t_s.
   std::function<std::expected<void, std::string>(double t_s)> wait_until;
   // The simulator's ports: its camera renders the frame inside next_frame(), which the tick's
-  // work figure (OnboardSummary::tick_work_us_*) then leaves out, as the simulator's time.
+  // work figure (OnboardSummary::tick_work_us_*) then leaves out, as the simulator's time; its
+  // candump log starts at OnboardOptions::simulated_log_epoch_unix_us instead of the wall clock.
   bool simulated = false;
 };
 
@@ -69,6 +71,11 @@ struct OnboardOptions {
   HeadControllerOptions controller;
   std::string candump_path;            // empty: no recording
   std::string candump_iface = "can0";
+  // The candump log is stamped on the Unix epoch, as candump stamps (head/log_clock.h). On the
+  // robot the loop's clock (CLOCK_MONOTONIC) is mapped through the system's wall clock; with
+  // simulated ports, simulated time 0 is written as this fixed date, so the same seed writes the
+  // same log (sim-run --log-epoch).
+  std::int64_t simulated_log_epoch_unix_us = kSimulatedLogEpochUnix_us;
   std::string diagnostics_path;        // JSON lines; empty: none
   // Detection (set_detector): lost results in a row before a frame goes to detection instead of
   // tracking (near the prediction first, then the whole search), and in Inline mode the
