@@ -17,6 +17,7 @@
 #include "epichead/firmware_iface/protocol.h"
 
 using nlohmann::json;
+using epichead::testing::lines_of;
 using epichead::testing::run_epichead;
 using epichead::testing::shell_quoted;
 using epichead::testing::TempDir;
@@ -42,13 +43,6 @@ const json& message(const json& j, const std::string& name) {
   FAIL("message " << name << " not in the report");
   static json none;
   return none;
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
 }
 
 }  // namespace

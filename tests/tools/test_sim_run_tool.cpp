@@ -17,6 +17,7 @@
 #include "common/temp_dir.h"
 
 using epichead::testing::run_epichead;
+using epichead::testing::lines_of;
 using epichead::testing::slurp;
 using epichead::testing::TempDir;
 
@@ -61,13 +62,6 @@ namespace {
 std::int64_t stamp_us(const std::string& line) {
   const auto dot = line.find('.');
   return std::stoll(line.substr(1, dot - 1)) * 1'000'000 + std::stoll(line.substr(dot + 1, 6));
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
 }
 
 }  // namespace
