@@ -459,7 +459,7 @@ const CommandRegistration registration{
                    "Measure the first frame (and the first after a loss) from the start pose only, without the "
                    "gradient pass that settles the start before the cue references are learnt");
       app.add_flag("!--no-outline-colours", a->outline_colours,
-                   "On those frames, do not weigh outline edges by the object's and the background's colours "
+                   "On the first frame, do not weigh outline edges by the object's and the background's colours "
                    "(learnt from the model drawn at the start pose; they tell a rim from a printed border inside it)");
       app.add_option("--ransac-seed", a->ransac_seed,
                      "Seed of the line RANSAC's sampler (default 2654435769): run a few to see how much a result hangs on the draw");

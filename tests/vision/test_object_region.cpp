@@ -100,10 +100,11 @@ TEST_CASE("a model that does not fill enough of the frame, or lies behind the ca
   CHECK_FALSE(region.ready());
 }
 
-TEST_CASE("from a start nearer a printed border than the rim, outline colours put the rim on the rim", "[object_region]") {
-  // The label's border is 8 px inside the rim; the start is 4 px small, so the border is the
-  // edge nearest the projection and the stronger one. Without references learnt yet, EPIC takes
-  // it; the colours beyond it (the white foot, the object's) say it is not the outline.
+TEST_CASE("from a start between a printed border and the rim, outline colours put the rim on the rim", "[object_region]") {
+  // The label's border is 8 px inside the rim; the start is 4 px small, half-way between them.
+  // The references, from beside the start's projection, are the label's red inside and the
+  // background outside: each edge agrees with one of them, and EPIC takes the border. The
+  // colours beyond it (the white foot, the object's) say it is not the outline.
   const double rim = 50, label = 42, start = 46;
   WindowImage image;
   REQUIRE(image.assign(frame(rim, label)));
@@ -112,7 +113,7 @@ TEST_CASE("from a start nearer a printed border than the rim, outline colours pu
   for (const bool weigh : {false, true}) {
     EllipseTrackerOptions options;
     options.mode = EpicMode::Epic;
-    options.side = RimSide::Inside;
+    options.side = RimSide::Both;
     EllipseTracker tracker(options);
     tracker.set_outline(weigh ? &region : nullptr);
     tracker.track_one(image, 0, circle_px(start), WindowPlacement::Projection);

@@ -27,11 +27,21 @@ inline std::string class_id(int view, int roll) { return "v" + std::to_string(vi
 struct Detector::Impl {
   Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
       : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
-        tracker(model_storage, c, t), visibility(model_storage, c, t.visibility), symmetries(model_symmetries(m)) {}
+        tracker(model_storage, c, without_outline_colours(t)), visibility(model_storage, c, t.visibility),
+        symmetries(model_symmetries(m)) {}
+
+  // A hypothesis can be off by more than the outline colours' margins, and then draws the
+  // background into the object's histogram: on the real tea box video the colours pulled the
+  // right hypothesis off the box and a wrong one won. The detector's trackers do without them.
+  static ModelTrackerOptions without_outline_colours(ModelTrackerOptions t) {
+    t.outline_colours = false;
+    return t;
+  }
 
   // The pull's windows are twice as wide as tracking's: a template's pose can be off by more
   // than a frame's motion.
   static ModelTrackerOptions wide(ModelTrackerOptions t) {
+    t = without_outline_colours(t);
     t.lines.window.width_px = std::min(kMaxWindowWidth, 2 * t.lines.window.width_px);
     t.max_jump_px = 2 * t.max_jump_px;
     return t;

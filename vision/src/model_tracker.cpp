@@ -328,7 +328,10 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
   out = FrameReport{};
   out.cam_T_obj = predicted;
   StageTimes settling;
-  if (!settled_ && options_.outline_colours && options_.mode != TrackMode::Gradient) {
+  // Only from a start (construction or reset: init.csv, a detection), which is near the
+  // object: after a loss the prediction may be far enough off to draw the background into the
+  // object's histogram (a mockup_walk step burst: re-locked 5 deg off with them).
+  if (!settled_ && !was_lost_ && options_.outline_colours && options_.mode != TrackMode::Gradient) {
     const auto t = Clock::now();
     if (region_.learn(image, *model_, camera_, predicted)) {
       lines_.set_outline(&region_);

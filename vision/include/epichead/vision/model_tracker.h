@@ -87,10 +87,11 @@ struct ModelTrackerOptions {
   // The first frame (and the first after a reset or a loss) is measured from the start pose
   // and from a gradient pass's pose, and the better supported start kept (settle()).
   bool settle = true;
-  // On those frames, whose cue references come only from the start pose, the model drawn at
-  // the start gives object and background colours (object_region.h), and edgels on the outline
-  // whose far side looks like the object weigh little: the references cannot yet tell a rim
-  // from a printed border just inside it (a can's label), but the colours beyond them can.
+  // On the first frame after a start (not after a loss), whose cue references come only from
+  // the start pose, the model drawn at it gives object and background colours (object_region.h),
+  // and edgels on the outline whose far side looks like the object weigh little: the references
+  // cannot yet tell a rim from a printed border just inside it (a can's label), the colours can.
+  // Not in the detector's own trackers (a hypothesis can be too far off).
   bool outline_colours = true;
   ObjectRegionOptions outline;
 };
@@ -177,7 +178,7 @@ class ModelTracker {
   TopologyValidator validator_;
   PoseEstimator estimator_;
   VisibleModel visible_;
-  ObjectRegion region_;  // learnt on the frames that settle (outline_colours)
+  ObjectRegion region_;  // learnt on the first frame after a start (outline_colours)
   ValidationResult validation_;
   PoseProblem problem_;
   PoseResult pose_;
