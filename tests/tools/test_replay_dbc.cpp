@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/json_entry.h"
 #include "common/run_tool.h"
 #include "epichead/firmware_iface/candump_writer.h"
 #include "epichead/firmware_iface/protocol.h"
@@ -37,13 +38,7 @@ json replay_json(const TempDir& dir, const std::string& args) {
   return json::parse(r.out);
 }
 
-const json& message(const json& j, const std::string& name) {
-  for (const auto& m : j["dbc"]["messages"])
-    if (m["message"] == name) return m;
-  FAIL("message " << name << " not in the report");
-  static json none;
-  return none;
-}
+const json& message(const json& j, const std::string& name) { return epichead::testing::entry_where(j["dbc"]["messages"], "message", name); }
 
 }  // namespace
 
