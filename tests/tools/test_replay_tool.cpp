@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "common/json_entry.h"
 #include "common/temp_dir.h"
 #include "epichead/firmware_iface/candump_writer.h"
 #include "epichead/firmware_iface/dronecan_raw_imu.h"
@@ -48,13 +49,7 @@ json replay_json(const std::string& log, const std::string& extra = "") {
 
 std::string shared(const std::string& name) { return std::string(EPICHEAD_SHARED_DATA) + "/can/" + name; }
 
-const json& id_entry(const json& j, const std::string& id) {
-  for (const auto& e : j["ids"])
-    if (e["id"] == id) return e;
-  FAIL("id " << id << " not in the report");
-  static json none;
-  return none;
-}
+const json& id_entry(const json& j, const std::string& id) { return epichead::testing::entry_where(j["ids"], "id", id); }
 
 }  // namespace
 
