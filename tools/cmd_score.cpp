@@ -20,6 +20,7 @@
 #include "command.h"
 #include "epichead/vision/model_symmetry.h"
 #include "line_selection_score.h"
+#include "epichead/vision/offline/pose_consistency.h"
 #include "epichead/vision/offline/score.h"
 #include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/offline/stamped_pose.h"
@@ -56,6 +57,17 @@ std::expected<Eigen::Vector3d, std::string> parse_axis(const std::string& text) 
 nlohmann::json stats_json(const ErrorStats& s) {
   // NaN (no frame with an estimate) becomes null in JSON.
   return {{"mean", s.mean}, {"median", s.median}, {"p95", s.p95}};
+}
+
+nlohmann::json to_json(const vision::PoseConsistency& c) {
+  return {{"dof", c.dof},
+          {"count", c.count},
+          {"mean", c.mean},
+          {"median", c.median},
+          {"within_95pct", c.within_95pct},
+          {"below_2_5pct", c.below_2_5pct},
+          {"above_97_5pct", c.above_97_5pct},
+          {"scale_for_mean", c.scale_for_mean}};
 }
 
 std::string number_or_empty(double v) {
@@ -162,6 +174,7 @@ const CommandRegistration registration{
       auto lines = std::make_shared<std::string>();
       auto symmetric = std::make_shared<bool>(false);
       auto include_hidden = std::make_shared<bool>(false);
+      auto covariance = std::make_shared<std::string>();
       app.add_option("SEQ", *seq_dir, "Sequence directory (with gt.csv)")->required();
       app.add_option("POSES", *poses_path, "Estimated poses: frame,t_s,tx,ty,tz,qw,qx,qy,qz[,status]")->required();
       app.add_flag("--json", *json,
@@ -182,6 +195,9 @@ const CommandRegistration registration{
                      "Compare with these poses instead of gt.csv (e.g. another tracker's reference_visp.csv)");
       app.add_option("--lines", *lines,
                      "The tracker's lines.csv: also score which image line it selected for each edge against the truth");
+      app.add_option("--covariance", *covariance,
+                     "The tracker's vision_covariance.csv: also report whether its covariances are honest (the NEES of "
+                     "the frames within 5 cm / 5 deg against chi-square, 6 degrees of freedom, 5 with --sym-axis)");
       app.add_option("--corners", *corners,
                      "FRAME:FILE: hand-read corners (X Y Z u v per line) of one frame; reports the distance of the "
                      "projected model points (repeatable)");
@@ -245,6 +261,12 @@ const CommandRegistration registration{
           if (!ls) return fail("score", ls.error());
           line_json = to_json(*ls);
         }
+        nlohmann::json consistency_json = nullptr;
+        if (!covariance->empty()) {
+          auto covs = vision::read_pose_covariance_csv(*covariance);
+          if (!covs) return fail("score", covs.error());
+          consistency_json = to_json(vision::pose_consistency(summary, *covs));
+        }
         std::set<int> truth_frames;
         for (const auto& g : truth_poses) truth_frames.insert(g.frame);
         int ignored = 0;
@@ -269,7 +291,8 @@ const CommandRegistration registration{
                                  {"reprojection_px", stats_json(summary.reprojection_px)},
                                  {"against", reference->empty() ? "gt.csv" : *reference},
                                  {"corners", *corner_json},
-                                 {"line_selection", line_json}};
+                                 {"line_selection", line_json},
+                                 {"covariance_consistency", consistency_json}};
           std::cout << j.dump() << std::endl;
         } else {
           print_human(*seq_dir, summary, ignored);
@@ -282,6 +305,15 @@ const CommandRegistration registration{
                           c["max_px"].get<double>());
             else
               std::printf("corners frame %d   no estimate (lost or absent)\n", c["frame"].get<int>());
+          if (!consistency_json.is_null() && consistency_json["count"].get<int>() == 0)
+            std::printf("covariance       no frame within 5 cm / 5 deg has a covariance\n");
+          else if (!consistency_json.is_null())
+            std::printf("covariance       NEES mean %.2f, median %.2f over %d frames (chi-square %d: mean %d); %.1f %% within "
+                        "its 95 %% bounds, %.1f %% above\n",
+                        consistency_json["mean"].get<double>(), consistency_json["median"].get<double>(),
+                        consistency_json["count"].get<int>(), consistency_json["dof"].get<int>(),
+                        consistency_json["dof"].get<int>(), 100 * consistency_json["within_95pct"].get<double>(),
+                        100 * consistency_json["above_97_5pct"].get<double>());
           if (!line_json.is_null())
             std::printf("line selection   %.1f %% right of %d; edges with a close parallel neighbour %.1f %% of %d\n",
                         100 * line_json["right_rate"].get<double>(), line_json["selections"].get<int>(),

@@ -1,6 +1,8 @@
 // `epichead track SEQ --out DIR [--mode gradient|epic|epic+validation] [--imu off|on]`: the full
 // model-based tracker over a sequence. Writes DIR/poses.csv (gt.csv columns + status; with
 // --imu on the filter's estimate, and the pose estimator's own in DIR/vision_poses.csv),
+// DIR/vision_covariance.csv (the pose estimator's covariance of each frame not lost, for
+// `score --covariance`),
 // DIR/report.json (summary + per-frame stage timings and feature counts), DIR/lines.csv (the
 // candidate selected for each visible edge, for `score --lines`), overlays every Nth
 // frame as DIR/overlay_NNNNNN.png and the whole run as DIR/overlay.mp4.
@@ -28,6 +30,7 @@
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/overlay.h"
+#include "epichead/vision/offline/pose_covariance_csv.h"
 #include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/offline/stamped_pose.h"
 #include "epichead/vision/window_image.h"
@@ -347,6 +350,7 @@ int run_track(const TrackArgs& args) {
   if (!(lines_csv << "frame,edge,found,candidates,a_x,a_y,b_x,b_y,inlier\n")) return fail(cmd, "cannot write " + args.out + "/lines.csv");
 
   std::vector<StampedPose> poses, vision_poses;
+  std::vector<vision::StampedCovariance> vision_covariances;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
   TrackCounts counts;
@@ -390,6 +394,7 @@ int run_track(const TrackArgs& args) {
       }
     poses.push_back({entry.frame, entry.t_s, estimate, to_string(report.status)});
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
+    if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));
 
     write_selected_lines(lines_csv, tracker, report, entry.frame);
@@ -407,6 +412,8 @@ int run_track(const TrackArgs& args) {
   if (args.imu == "on")
     if (auto ok = write_pose_csv((fs::path(args.out) / "vision_poses.csv").string(), vision_poses); !ok)
       return fail(cmd, ok.error());
+  if (auto ok = write_pose_covariance_csv((fs::path(args.out) / "vision_covariance.csv").string(), vision_covariances); !ok)
+    return fail(cmd, ok.error());
   nlohmann::json j = report_json(args, n, counts,
                                  track_ms, *predictor ? predictor->get() : nullptr, tracker);
   j["acquisition"] = acquisition.to_json();

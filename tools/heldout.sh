@@ -19,6 +19,7 @@ bin="$here/build/bin/epichead"
 # One scenario and seed: simulate, track every mode with and without the IMU, score. Rows:
 # scenario seed set mode imu success success_2cm_2deg rot_med_deg transl_med_mm nis_mean nis_within nis_count
 #   success_no_sym (IMU runs of a body of revolution: scored without removing the turn) fallback_frames
+#   nees_count nees_mean nees_within (the vision poses' covariance against the truth: score --covariance)
 one() {
   local out="$1" frames="$2" scenario="$3" seed="$4" set="$5"
   [[ "$frames" == all ]] && frames=""
@@ -45,18 +46,26 @@ one() {
       axis=$(jq -r 'if .free_turn_axis then (.free_turn_axis.direction_obj | map(tostring) | join(",")) else "" end' "$dir/report.json")
       [[ -n "$axis" ]] && sym=(--sym-axis "$axis")
       "$bin" score "$seq" "$dir/poses.csv" --json "${sym[@]}" > "$dir/score.json"
+      # The vision covariance against the truth: the pose estimator's own poses (with the IMU
+      # poses.csv holds the filter's).
+      local vision_poses="$dir/poses.csv"
+      [[ "$imu" == on ]] && vision_poses="$dir/vision_poses.csv"
+      "$bin" score "$seq" "$vision_poses" --json "${sym[@]}" --covariance "$dir/vision_covariance.csv" > "$dir/score_covariance.json"
       local no_sym="-"
       if [[ -n "$axis" && "$imu" == on ]]; then
         "$bin" score "$seq" "$dir/poses.csv" --json > "$dir/score_no_sym.json"
         no_sym=$(jq -r '.success_rate * 100' "$dir/score_no_sym.json")
       fi
-      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$scenario" "$seed" "$set" "$mode" "$imu" \
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$scenario" "$seed" "$set" "$mode" "$imu" \
         "$(jq -r '.success_rate * 100' "$dir/score.json")" "$(jq -r '.success_rate_2cm_2deg * 100' "$dir/score.json")" \
         "$(jq -r '.rotation_deg.median // "nan"' "$dir/score.json")" "$(jq -r '.translation_mm.median // "nan"' "$dir/score.json")" \
         "$(jq -r '.predictor.vision_nis.mean // "-"' "$dir/report.json")" \
         "$(jq -r '.predictor.vision_nis.within_95pct_bounds // "-"' "$dir/report.json")" \
         "$(jq -r '.predictor.vision_nis.count // 0' "$dir/report.json")" "$no_sym" \
-        "$(jq -r '.fallback_frames // 0' "$dir/report.json")" >> "$rows.part"
+        "$(jq -r '.fallback_frames // 0' "$dir/report.json")" \
+        "$(jq -r '.covariance_consistency.count' "$dir/score_covariance.json")" \
+        "$(jq -r '.covariance_consistency.mean // "nan"' "$dir/score_covariance.json")" \
+        "$(jq -r '.covariance_consistency.within_95pct // "nan"' "$dir/score_covariance.json")" >> "$rows.part"
     done
   done
   mv "$rows.part" "$rows"

@@ -92,6 +92,19 @@ echo "|---|---|---|---|---|"
 awk -F'\t' '$3 == "held" && $5 == "on" && $12 > 0 { k = $1 "\t" $4; n[k] += $12; m[k] += $10 * $12; w[k] += $11 * $12 }
   END { for (k in n) { split(k, p, "\t"); printf "| %s | %s | %d | %.1f | %.1f %% |\n", p[1], p[2], n[k], m[k] / n[k], 100 * w[k] / n[k] } }' "$rows" | sort
 echo
+echo "### Vision covariance against the truth (held-out)"
+echo
+echo "Normalised estimation error squared of each vision pose within 5 cm / 5 deg, against the"
+echo "covariance the tracker gives the filter (\`score --covariance\`, vision_covariance.csv; the pose"
+echo "estimator's own poses, with the IMU too): with honest covariances chi-square with 6 dof (5 for"
+echo "a body of revolution, its turn left out), mean 6 (5) and 95 % within its 2.5-97.5 % quantiles."
+echo "Pooled over the held-out runs of each scenario, mode and IMU setting."
+echo
+echo "| scenario | mode | IMU | frames | mean NEES | within 95 % bounds |"
+echo "|---|---|---|---|---|---|"
+awk -F'\t' '$3 == "held" && $15 > 0 && $16 != "nan" { k = $1 "\t" $4 "\t" $5; n[k] += $15; m[k] += $16 * $15; w[k] += $17 * $15 }
+  END { for (k in n) { split(k, p, "\t"); printf "| %s | %s | %s | %d | %.1f | %.1f %% |\n", p[1], p[2], p[3], n[k], m[k] / n[k], 100 * w[k] / n[k] } }' "$rows" | sort
+echo
 echo "## Development seeds"
 echo
 header

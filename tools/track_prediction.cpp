@@ -186,8 +186,7 @@ class ImuPredictor final : public TrackPredictor {
     // ~0.3 m/s: the translation ran off 26 mm per frame (office_pan, development seed 3).
     if (seeded_by_init_ && t_s <= init_t_s_) predictor_.reset();
     seeded_by_init_ = false;
-    const Matrix6 cov = vision::kTrackedPoseCovarianceInflation * report.covariance;
-    auto r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
+    auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
     // Vision and the filter disagree: which is wrong? A pose found only from the vision-only
     // extrapolation says the IMU's prediction had left the object; a run of gated poses that
@@ -198,7 +197,7 @@ class ImuPredictor final : public TrackPredictor {
     else supported_gated_ = 0;
     if ((report.used_fallback && strong) || supported_gated_ >= kSupportedGatedRestart) {
       predictor_.reset();
-      r = predictor_.add_vision(t_s, report.cam_T_obj, cov);
+      r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
       supported_gated_ = 0;
       ++(report.used_fallback ? fallback_restarts_ : gated_restarts_);
     }
@@ -294,7 +293,7 @@ class ImuPredictor final : public TrackPredictor {
     next_ = 0;
     while (next_ < imu.size() && imu[next_].t_s - offset_s_ < t_s - options_.gravity_average_s - 0.05) ++next_;
     feed_until(t_s);
-    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, vision::kTrackedPoseCovarianceInflation * report.covariance);
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
     init_t_s_ = t_s;
   }

@@ -1,14 +1,16 @@
 // The sequence CSV readers (stamped_pose.h, sequence.h): the first input byte picks the file,
 // the rest is its text: 'i' init.csv and 'g' gt.csv (read_pose_csv), 'u' imu.csv
-// (read_imu_csv), 'f' frames.csv (read_frames_csv); any other byte picks by its value modulo 4.
+// (read_imu_csv), 'f' frames.csv (read_frames_csv), 'c' vision_covariance.csv
+// (read_pose_covariance_csv); any other byte picks by its value modulo 5.
 // Properties: rows or a one-line error naming the file, never a crash; what was read, written
 // by the matching writer, reads back the same (times and IMU values exactly, poses to the
-// writer's 9 significant digits).
+// writer's 9 significant digits, covariances exactly).
 #include <cmath>
 #include <string>
 
 #include <Eigen/Geometry>
 
+#include "epichead/vision/offline/pose_covariance_csv.h"
 #include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/offline/stamped_pose.h"
 #include "fuzz_support.h"
@@ -18,7 +20,7 @@ using epichead::fuzz::check;
 
 namespace {
 
-enum class Kind { Init, Gt, Imu, Frames };
+enum class Kind { Init, Gt, Imu, Frames, Covariance };
 
 Kind pick(std::uint8_t b) {
   switch (b) {
@@ -26,7 +28,8 @@ Kind pick(std::uint8_t b) {
     case 'g': return Kind::Gt;
     case 'u': return Kind::Imu;
     case 'f': return Kind::Frames;
-    default: return static_cast<Kind>(b % 4);
+    case 'c': return Kind::Covariance;
+    default: return static_cast<Kind>(b % 5);
   }
 }
 
@@ -92,6 +95,24 @@ void frames(const std::string& path) {
   }
 }
 
+void covariances(const std::string& path) {
+  auto a = read_pose_covariance_csv(path);
+  if (!a) return check_error(a, path);
+  const std::string again = path + ".written";
+  const auto w = write_pose_covariance_csv(again, *a);
+  check(w.has_value(), "write_pose_covariance_csv failed: " + (w ? std::string() : w.error()));
+  auto b = read_pose_covariance_csv(again);
+  check(b.has_value(), "a written covariance file does not read back: " + (b ? std::string() : b.error()));
+  check(a->size() == b->size(), "row count changed");
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const auto& p = (*a)[i];
+    const auto& q = (*b)[i];
+    check(p.frame == q.frame && p.t_s == q.t_s, "frame or time changed");
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) check(p.covariance(r, c) == q.covariance(r, c), "a covariance entry changed");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -104,6 +125,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case Kind::Gt: poses(scratch.write("gt.csv", text)); break;
     case Kind::Imu: imu(scratch.write("imu.csv", text)); break;
     case Kind::Frames: frames(scratch.write("frames.csv", text)); break;
+    case Kind::Covariance: covariances(scratch.write("vision_covariance.csv", text)); break;
   }
   return 0;
 }

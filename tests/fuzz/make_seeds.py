@@ -61,6 +61,7 @@ def csvs(out):
           "0.005,0.011,-0.021,0.49,0.12,-9.8,0.19\n0.01,1e-3,2.5e-4,-0.5,0,-9.79,0\n")
     write(out, "sequence_csv", "frames", "fframe,t_s,file\n0,0.2,frames/000000.png\n1,0.2333333333333333,frames/000001.png\n")
     write(out, "sequence_csv", "frames_video", "fframe,t_s,file\n0,0,\n1,0.04,\n2,0.08,\n")
+    write(out, "sequence_csv", "covariance", "cframe,t_s,c_tx_tx,c_tx_ty,c_tx_tz,c_tx_rx,c_tx_ry,c_tx_rz,c_ty_ty,c_ty_tz,c_ty_rx,c_ty_ry,c_ty_rz,c_tz_tz,c_tz_rx,c_tz_ry,c_tz_rz,c_rx_rx,c_rx_ry,c_rx_rz,c_ry_ry,c_ry_rz,c_rz_rz\n0,0,1e-06,2e-07,2e-07,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,1e-06,2e-07,1e-06\n3,0.1,1e-06,2e-07,2e-07,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,2e-07,1e-06,2e-07,2e-07,1e-06,2e-07,1e-06\n")
 
 
 def candump(out):

@@ -49,6 +49,18 @@ TEST_CASE("track follows a short simulated mockup_walk with epic+validation and 
   CHECK(s["success_rate"].get<double>() >= 0.95);
   CHECK(s["rotation_deg"]["median"].get<double>() < 1.0);
   CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+
+  // The covariance the tracker gives the filter, checked against the truth.
+  const auto checked = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --json --covariance " +
+                                             q(out + "/vision_covariance.csv"));
+  INFO(checked.err);
+  REQUIRE(checked.exit_code == 0);
+  const auto c = nlohmann::json::parse(checked.out)["covariance_consistency"];
+  CHECK(c["dof"] == 6);
+  CHECK(c["count"].get<int>() >= 36);
+  // Honest within a factor of a few here (docs/fusion.md gives the figures per scenario).
+  CHECK(c["scale_for_mean"].get<double>() > 0.2);
+  CHECK(c["scale_for_mean"].get<double>() < 5.0);
 }
 
 TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the tracked poses (auto) and tracks every frame") {

@@ -92,6 +92,9 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   }
   problem_.points.reserve(model.vertices.size());
   if (options.free_turn_of_revolution) problem_.free_turn = find_revolution_axis(model);
+  // A smooth body's facets are the model's error at every edge (its contour and its rims).
+  if (problem_.free_turn)
+    for (LineObservation& obs : problem_.lines) obs.model_error_m = problem_.free_turn->facet_sagitta_m;
   // Model edges that are chords of a model circle (both ends on it): the facets' outline of a
   // rim the circle itself describes.
   chord_of_circle_.assign(edges, -1);

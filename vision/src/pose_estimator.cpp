@@ -215,13 +215,21 @@ void degeneracy_and_covariance(const PoseProblem& problem, const PoseOptions& op
   const double sigma2 = std::max(floor2, ne.wsum > basis.dims ? ne.wr2 / (ne.wsum - basis.dims) : 1.0);
   if (out.status != PoseStatus::Ok) {
     out.covariance = Matrix6d::Identity() * 1e6;
-  } else if (basis.dims == 6) {
-    out.covariance = sigma2 * H.inverse();
+    return;
+  }
+  // H^-1 within the directions the features fix.
+  Matrix6d H_inv;
+  if (basis.dims == 6) {
+    H_inv = H.inverse();
   } else {
     const Eigen::Matrix<double, 6, 5> B = basis.B.leftCols<5>();
-    const Eigen::Matrix<double, 5, 5> H5 = H_fixed.topLeftCorner<5, 5>();
+    H_inv = B * H_fixed.topLeftCorner<5, 5>().inverse() * B.transpose();
+  }
+  // Independent edgel noise, plus what each line's edgels share (ne.shared).
+  out.covariance = sigma2 * H_inv + H_inv * ne.shared * H_inv;
+  if (basis.dims < 6) {
     const double s = problem.free_turn_sigma_rad;
-    out.covariance = sigma2 * B * H5.inverse() * B.transpose() + (s * s) * basis.turn * basis.turn.transpose();
+    out.covariance += (s * s) * basis.turn * basis.turn.transpose();
   }
 }
 
@@ -315,7 +323,7 @@ void PoseEstimator::estimate(const PoseProblem& problem, const Eigen::Isometry3d
   out.cam_T_obj = pose;
   out.scale_px = robust_scale(terms, pose, options_.min_scale_px, residual_scratch_);
   NormalEquations ne;
-  terms.normal_equations(pose, Tukey(options_.tukey_c * out.scale_px), ne);
+  terms.normal_equations(pose, Tukey(options_.tukey_c * out.scale_px), ne, std::max(0.0, options_.line_shared_sigma_px));
   degeneracy_and_covariance(problem, options_, ne, out);
   feature_rms(terms, pose, feature_sq_, feature_n_);
   feature_residuals(problem, options_, feature_sq_, feature_n_, rejected_, out);

@@ -1,5 +1,7 @@
 #include "pose_terms.h"
 
+#include <algorithm>
+
 #include <Eigen/LU>
 
 #include "epichead/geometry/so3.h"
@@ -12,11 +14,17 @@ namespace epichead::vision::detail {
 // (dl^T M dl) instead of once per edgel. The same sums as per-edgel rows, grouped differently
 // (round-off only).
 void add_line_block(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
-                    const Tukey& k, NormalEquations& ne) {
+                    const Tukey& k, NormalEquations& ne, double shared_sigma_px) {
+  const bool shared_errors = shared_sigma_px >= 0;
   const Eigen::Vector3d& l = img.l;
   const double s = img.s;
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  // For the shared errors: sums of w dr/dl and of w t dr/dl with t the edgel's place along the
+  // line (normalised coordinates), of w and w t, and t's extent.
+  Eigen::Vector3d s0 = Eigen::Vector3d::Zero(), s1 = Eigen::Vector3d::Zero();
+  double w0 = 0, wt = 0, t_min = 0, t_max = 0;
+  const Eigen::Vector2d along(-l.y() / s, l.x() / s);
   for (std::size_t q = 0; q < obs.edgels_px.size(); ++q) {
     const double r = line_residual(obs, img, xns[q], focal);
     const double w = k.weight(r);  // no skip at w = 0: a non-finite row must still reach H
@@ -29,6 +37,15 @@ void add_line_block(const LineObservation& obs, const LineImage& img, const Eige
     v += (w * r) * dr_dl;
     ne.wr2 += w * r * r;
     ne.wsum += w;
+    if (shared_errors) {
+      const double t = along.dot(xns[q]);
+      s0 += w * dr_dl;
+      s1 += (w * t) * dr_dl;
+      w0 += w;
+      wt += w * t;
+      t_min = q ? std::min(t_min, t) : t;
+      t_max = q ? std::max(t_max, t) : t;
+    }
   }
   // dl/dxi of l = A x B under a left perturbation of the pose: dA = [I | -[A]x] dxi (same for
   // B), so dl = [A - B]x dt - [l]x dphi (using [B]x[A]x - [A]x[B]x = [B x A]x).
@@ -37,6 +54,17 @@ void add_line_block(const LineObservation& obs, const LineImage& img, const Eige
   dl.rightCols<3>() = -geometry::skew(l);
   ne.H.noalias() += dl.transpose() * M * dl;
   ne.g.noalias() += dl.transpose() * v;
+  if (shared_errors && w0 > 0 && t_max > t_min) {
+    // The model's error in pixels at the segment's mean depth.
+    const double depth = 0.5 * (img.A.z() + img.B.z());
+    const double model_px = depth > 0 ? focal * obs.model_error_m / depth : 0.0;
+    const double s2 = shared_sigma_px * shared_sigma_px + model_px * model_px;
+    // Per pixel: dr is in units of sigma_px. The turn is about the weighted centre.
+    const double half = (t_max - t_min) / 2, centre = wt / w0;
+    const Vector6d a = dl.transpose() * s0 / obs.sigma_px;
+    const Vector6d b = dl.transpose() * (s1 - centre * s0) / (half * obs.sigma_px);
+    ne.shared.noalias() += s2 * (a * a.transpose() + b * b.transpose());
+  }
 }
 
 Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::Isometry3d& cam_T_obj) {
@@ -49,12 +77,13 @@ Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::
   return Qi.transpose() * Eigen::Vector3d(1, 1, -1).asDiagonal() * Qi;
 }
 
-void PoseTerms::normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne) const {
+void PoseTerms::normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne,
+                                 double shared_sigma_px) const {
   ne = NormalEquations{};
   for (std::size_t i = 0; i < problem_.lines.size(); ++i) {
     const LineObservation& obs = problem_.lines[i];
     if (obs.edgels_px.size() < 2 || skip(static_cast<int>(i), Rejected::Skip)) continue;
-    add_line_block(obs, line_image(obs, cam_T_obj), line_edgels(i), focal_, k, ne);
+    add_line_block(obs, line_image(obs, cam_T_obj), line_edgels(i), focal_, k, ne, shared_sigma_px);
   }
   rows(cam_T_obj, Rejected::Skip, true, [&](double r, const RowJ& J, int) { ne.add_row(r, J, k); });
 }

@@ -49,6 +49,13 @@ struct NormalEquations {
   Matrix6d H = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
   double wr2 = 0, wsum = 0, cost = 0;
+  // With shared errors asked for (the final equations only): sum over lines of s^2 (a a' + b b'),
+  // where a = sum w dr/dxi is what a shift of the whole line by one pixel does to the gradient,
+  // b = sum w u dr/dxi what a turn of it does that moves its ends by one pixel (u in [-1, 1]
+  // along the line), and s the line's shared error in pixels. The solution moves by H^-1 a per
+  // pixel of shift: errors every edgel of a line shares (the model's, a blurred edge's) do not
+  // average out over its edgels.
+  Matrix6d shared = Matrix6d::Zero();
   // One residual row r with its Jacobian row J. No skip at w = 0: a non-finite row must reach H.
   void add_row(double r, const RowJ& J, const Tukey& k) {
     const double w = k.weight(r);
@@ -90,7 +97,7 @@ void line_residuals(const LineObservation& obs, const LineImage& img, const Eige
 
 // The line's block of the normal equations, formed once per line rather than once per edgel.
 void add_line_block(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
-                    const Tukey& k, NormalEquations& ne);
+                    const Tukey& k, NormalEquations& ne, double shared_sigma_px);
 
 // ---- Junctions: fn(r, J) for the two rows (x, then y); J is left unset without want_jacobian.
 template <class Fn>
@@ -182,7 +189,10 @@ class PoseTerms {
   }
 
   // The normal equations at cam_T_obj under kernel k, from scratch; rejected features left out.
-  void normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne) const;
+  // With shared errors (shared_sigma_px >= 0: PoseOptions::line_shared_sigma_px) also
+  // NormalEquations::shared, for the covariance.
+  void normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne,
+                        double shared_sigma_px = -1) const;
 
   // The observed segments and junctions are in front of the camera. Only lines with edgels count:
   // a caller may keep empty slots for every model edge, and an unseen edge may well run behind

@@ -76,6 +76,8 @@ std::optional<RevolutionAxis> find_revolution_axis(const CadModel& model, int mi
     if (static_cast<int>(g.angles_rad.size()) < min_ring_vertices) return std::nullopt;
     // Round-off of a vertex written with a few decimals moves it by ~tol_m, i.e. tol_m / r rad.
     if (!evenly_spaced(g.angles_rad, 2 * tol_m / g.radius_m + 1e-6)) return std::nullopt;
+    const double n = static_cast<double>(g.angles_rad.size());
+    axis.facet_sagitta_m = std::max(axis.facet_sagitta_m, g.radius_m * (1 - std::cos(std::numbers::pi / n)));
   }
   return axis;
 }

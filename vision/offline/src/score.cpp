@@ -11,6 +11,8 @@
 
 #include <Eigen/Geometry>
 
+#include "epichead/geometry/se3.h"
+
 namespace epichead::vision {
 namespace {
 
@@ -132,6 +134,13 @@ ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std
       const double translation_m = (est_T.translation() - gt->cam_T_obj.translation()).norm();
       s.translation_mm = 1000.0 * translation_m;
       s.reprojection_px = reprojection_error_px(points, camera, gt->cam_T_obj, est_T);
+      s.error_twist = geometry::se3_log(gt->cam_T_obj * est_T.inverse());
+      if (axis) {
+        // A turn by theta about the line through the object origin c along w moves a point p by
+        // theta * (w x p + c x w): the left perturbation (c x w, w).
+        const Eigen::Vector3d w = est_T.linear() * *axis;
+        s.axis_twist << est_T.translation().cross(w), w;
+      }
       s.success = translation_m <= criterion.max_translation_m && s.rotation_deg <= criterion.max_rotation_deg;
       s.success_tight = translation_m <= criterion.tight_translation_m && s.rotation_deg <= criterion.tight_rotation_deg;
       ++summary.present;

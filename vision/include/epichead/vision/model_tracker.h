@@ -112,7 +112,10 @@ struct FrameReport {
   TrackStatus status = TrackStatus::Lost;
   TrackReason reasons = TrackReason::None;
   Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();  // the estimate (the prediction when lost)
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();  // left perturbation (t, r)
+  // Left perturbation (t, r), in m and rad: the pose estimator's, with each line's shared error
+  // (PoseOptions::line_shared_sigma_px, a smooth body's facets): what a filter is given, and
+  // what `track` writes to vision_covariance.csv for `score --covariance` to check.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
   PoseStatus pose_status = PoseStatus::Ok;
   double scale_px = 0;             // robust residual scale of the pose
   int pose_iterations = 0;         // Levenberg-Marquardt iterations over all rejection rounds

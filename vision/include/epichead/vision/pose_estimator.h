@@ -22,6 +22,10 @@ struct LineObservation {
   Eigen::Vector3d a_obj = Eigen::Vector3d::Zero(), b_obj = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector2d> edgels_px;
   double sigma_px = 1.0;  // expected edgel noise
+  // The model's own error at this edge, in metres (1-sigma), shared by all its edgels: e.g. the
+  // facets of a smooth body (RevolutionAxis::facet_sagitta_m). Adds to
+  // PoseOptions::line_shared_sigma_px, scaled to pixels at the edge's depth.
+  double model_error_m = 0;
 };
 
 // A model vertex seen at a pixel (a junction from intersecting fitted lines).
@@ -72,6 +76,13 @@ struct PoseOptions {
   double convergence_step = 1e-10;   // stop when the update's norm falls below this
   // Floor of the residual noise the covariance is scaled by, in units of each feature's sigma.
   double min_noise_sigma = 0.25;
+  // The error every edgel of a line shares, in pixels (1-sigma), both as a shift of the whole
+  // line and as a turn moving its ends: a CAD model off by a millimetre and a blurred edge's
+  // bias do not average out over a line's edgels the way independent noise does (a line's
+  // model_error_m adds to it). It replaced a flat x10 on the covariance: chosen on the
+  // development seeds for a mean NEES near its degrees of freedom (docs/fusion.md, "Honest
+  // vision covariance"). 0: edgels independent.
+  double line_shared_sigma_px = 0.5;
 };
 
 enum class PoseStatus {
@@ -122,16 +133,6 @@ class PoseEstimator {
   std::vector<Eigen::Vector2d> normalized_;               // undistorted edgels and ellipse points
   std::vector<std::size_t> offsets_;                      // per line, then per ellipse: start in normalized_
 };
-
-// PoseResult::covariance assumes independent edgels; neighbouring edgels of one blurred edge are
-// not, and the model's own errors move all of a feature's edgels together: a consumer that feeds
-// tracked poses to a filter (`epichead track`, the onboard loop) scales it by this first. Chosen on
-// the development seeds (docs/results.md): with the estimator's residual noise now floored at
-// 0.25 px instead of 1 px, x10 weighs vision up to 4x more than before; x3 (the NIS's choice on
-// sharp scenes) lost box_clutter's own seed with the IMU (100 -> 12 %: vision gated while the
-// filter drifted before the clock offset was known) and no development seed tracked better, so
-// the consistency of the NIS is not bought with that.
-inline constexpr double kTrackedPoseCovarianceInflation = 10.0;
 
 // The covariance of a starting pose given by hand or by init.csv: 1 cm and 1 degree (1-sigma per
 // axis), in the order of geometry/pose_covariance.h.

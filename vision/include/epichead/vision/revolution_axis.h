@@ -17,6 +17,11 @@ namespace epichead::vision {
 struct RevolutionAxis {
   Eigen::Vector3d point_obj = Eigen::Vector3d::Zero();      // a point on the axis
   Eigen::Vector3d direction_obj = Eigen::Vector3d::UnitZ();  // unit
+  // How far the facets lie from the smooth body they stand for, at most: a ring of n vertices
+  // at radius r is a polygon whose sides come r (1 - cos(pi / n)) inside the circle. The edges
+  // of such a model, and the contour the real surface shows, are this far apart, wherever the
+  // object is turned.
+  double facet_sagitta_m = 0;
 };
 
 // The axis when the whole model is invariant under turns about it up to its facets: every

@@ -2,6 +2,7 @@
 // Scoring of estimated poses against ground truth: per-frame rotation, translation and
 // reprojection errors, success under the 5 cm / 5 degree criterion, and a summary.
 #include <expected>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,13 @@ struct FrameScore {
   bool success = false;   // present and within the criterion
   bool success_tight = false;  // present and within the tight criterion
   double rotation_deg = 0, translation_mm = 0, reprojection_px = 0;  // NaN when absent
+  // The error as a left perturbation (geometry/pose_covariance.h): truth = se3_exp(error_twist) *
+  // estimate, after the symmetry turns are taken out; NaN when absent.
+  Eigen::Matrix<double, 6, 1> error_twist = Eigen::Matrix<double, 6, 1>::Constant(std::numeric_limits<double>::quiet_NaN());
+  // With a symmetry axis: the direction, in the same coordinates, of a turn about that axis at the
+  // estimate (unit rotation part). The error has no component the scoring can see along it, so a
+  // covariance check leaves it out. Zero without an axis.
+  Eigen::Matrix<double, 6, 1> axis_twist = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
 struct ErrorStats { double mean = 0, median = 0, p95 = 0; };
