@@ -51,18 +51,18 @@ struct Pty {
   }
 };
 
-// `epichead ARGS...` with stderr on a pseudo-terminal (stdout to a file, stdin from /dev/null):
+// `PROGRAM ARGS...` with stderr on a pseudo-terminal (stdout to a file, stdin from /dev/null):
 // the exit code and what reached the terminal.
 struct PtyRun {
   int exit_code = -1;
   std::string terminal;
 };
 
-PtyRun run_with_stderr_on_pty(const TempDir& scratch, const std::vector<std::string>& args) {
+PtyRun run_on_pty(const TempDir& scratch, const std::string& program, const std::vector<std::string>& args) {
   int master = -1, slave = -1;
   REQUIRE(::openpty(&master, &slave, nullptr, nullptr, nullptr) == 0);
   // Everything the child needs is made before fork: it only redirects and execs.
-  std::vector<std::string> words{EPICHEAD_BIN};
+  std::vector<std::string> words{program};
   words.insert(words.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());
@@ -94,6 +94,14 @@ PtyRun run_with_stderr_on_pty(const TempDir& scratch, const std::vector<std::str
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+PtyRun run_with_stderr_on_pty(const TempDir& scratch, const std::vector<std::string>& args) {
+  return run_on_pty(scratch, EPICHEAD_BIN, args);
+}
+
+// A script using tools/progress.sh, as results.sh and heldout.sh do.
+const std::string kShellProgress = ". '" EPICHEAD_SOURCE_DIR "/tools/progress.sh'; set -eu; progress_start demo 3 runs; "
+                                   "progress_step; progress_say 'demo: a message'; progress_step 2; progress_end; echo end";
 
 }  // namespace
 
@@ -235,4 +243,24 @@ TEST_CASE("a command that fails on a terminal starts its message on a clean line
   REQUIRE(message != std::string::npos);
   REQUIRE(message > 0);
   CHECK(track.terminal[message - 1] == '\r');  // the wiped line ends with a carriage return
+}
+
+TEST_CASE("tools/progress.sh: a progress line on a terminal, messages above it, nothing when stderr is a file") {
+  TempDir tmp("epichead_test_progress_sh");
+  const auto tty = run_on_pty(tmp, "/bin/bash", {"-c", kShellProgress});
+  INFO(tty.terminal);
+  REQUIRE(tty.exit_code == 0);
+  CHECK(tty.terminal.find("\rdemo: 0/3 runs  0:0") != std::string::npos);
+  CHECK(tty.terminal.find("demo: 1/3 runs  0:0") != std::string::npos);
+  CHECK(tty.terminal.find(" left") != std::string::npos);
+  CHECK(tty.terminal.find("demo: 3/3 runs  0:0") != std::string::npos);
+  CHECK(tty.terminal.find(" taken") != std::string::npos);
+  const std::string out = epichead::testing::slurp(tmp / "stdout.txt");
+  CHECK(out == "demo: a message\nend\n");  // stdout gets the messages only
+
+  const std::string err_path = tmp / "err.txt";
+  const std::string command = "/bin/bash -c \"" + kShellProgress + "\" > '" + (tmp / "out.txt") + "' 2> '" + err_path + "'";
+  REQUIRE(std::system(command.c_str()) == 0);
+  CHECK(epichead::testing::slurp(err_path).empty());
+  CHECK(epichead::testing::slurp(tmp / "out.txt") == "demo: a message\nend\n");
 }
