@@ -126,6 +126,7 @@ make_inputs() {
   put run_notjson.json '{ "model": '
   put run_nokey.json '{ "camera_calibration": "c.yaml", "init_pose": "i.csv" }'
   put run_type.json '{ "model": 3, "camera_calibration": "c.yaml", "init_pose": "i.csv" }'
+  put run_unknown.json '{ "model": "m.cao", "camera_calibration": "c.yaml", "camera": { "widht": 1280 } }'
   put run_mode.json "{ \"model\": \"$teabox/model.cao\", \"camera_calibration\": \"$teabox/camera.yaml\", \"init_pose\": \"$teabox/init.csv\", \"mode\": \"dance\" }"
 }
 
@@ -236,6 +237,7 @@ O="--out out --no-video --every 0 --frames 2"
   run 1 "run: configuration without model" run --config run_nokey.json
   run 1 "run: model is a number" run --config run_type.json
   run 1 "run: unknown head mode" run --config run_mode.json
+  run 1 "run: misspelt key (camera.widht)" run --config run_unknown.json
   run 2 "option: unknown command" foo
   run 2 "option: no command" 
   run 2 "option: --every not a number" $T model_missing --out out --every nope

@@ -3,9 +3,9 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <unistd.h>
 
 #include "command.h"
+#include "progress.h"
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/sequence_writer.h"
 
@@ -55,13 +55,14 @@ const CommandRegistration registration{
           else if (s->motion == sim::MotionKind::handheld) s->handheld.jerk = *jerk;
           else return fail("sim", "--jerk applies to walking and hand-held motion; scenario '" + s->name + "' is wheeled");
         }
-        const bool tty = isatty(STDERR_FILENO) != 0;
-        auto progress = [tty](int i, int n) {
-          if (tty && (i % 10 == 9 || i + 1 == n)) std::fprintf(stderr, "\rframe %d/%d", i + 1, n);
-          if (tty && i + 1 == n) std::fprintf(stderr, "\n");
-        };
-        auto summary = sim::write_sequence(*s, *out, progress);
+        // Frames rendered and written, on stderr when it is a terminal (progress.h).
+        Progress progress("sim", "frames", s->frames);
+        auto summary = sim::write_sequence(*s, *out, [&progress](int i, int n) {
+          progress.set_total(n);
+          progress.update(i + 1);
+        });
         if (!summary) return fail("sim", summary.error());
+        progress.finish();
         std::printf("epichead sim: wrote %s (scenario %s, seed %llu, variety %g)\n", out->c_str(), s->name.c_str(),
                     static_cast<unsigned long long>(s->seed), s->variety);
         std::printf("%d frames over %.2f s, peak body angular rate %.1f deg/s, %d IMU samples (%d dropped, %d saturated)\n",

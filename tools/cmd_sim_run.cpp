@@ -31,6 +31,7 @@
 #include "detection_setup.h"
 #include "onboard_summary_json.h"
 #include "process_memory.h"
+#include "progress.h"
 #include "plot/line_plot.h"
 #include "epichead/head/onboard_loop.h"
 #include "epichead/head/target_observation.h"
@@ -233,11 +234,19 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
   ++m.frames;
 }
 
+// Where one run's frames go on the progress line: the runs one after the other.
+struct RunProgress {
+  Progress& line;
+  long first_frame;  // frames of the runs before this one
+  double fps;
+};
+
 // One closed run. `detector` (may be null) finds the object without a start pose (--no-init)
 // and after losses; the run takes it.
 std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& scenario, const SimRunArgs& a,
                                                           head::ControlMode mode, bool render, const std::string& out,
-                                                          RunMeasures& m, std::unique_ptr<vision::Detector> detector = {}) {
+                                                          RunMeasures& m, const RunProgress& progress,
+                                                          std::unique_ptr<vision::Detector> detector = {}) {
   sim::SimWorldOptions wo;
   wo.camera = render ? sim::CameraOutput::Render : sim::CameraOutput::Blank;
   wo.camera_downscale = a.downscale;
@@ -279,6 +288,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   ports.wait_until = [&](double t_s) -> std::expected<void, std::string> {
     if (auto ok = w.advance_to(t_s); !ok) return ok;
     if (wall) std::this_thread::sleep_until(wall_start + std::chrono::duration<double>(t_s - sim_start_s));
+    progress.line.update(progress.first_frame + static_cast<long>(t_s * progress.fps));  // cheap: throttled, no allocation
     return meter.sample(t_s);
   };
   auto loop = head::OnboardLoop::create(*model, cam, o, ports);
@@ -394,22 +404,31 @@ int run_sim_run(const SimRunArgs& given) {
     if (!d) return fail(cmd, d.error());
     detector = std::move(*d);
   }
-  RunMeasures closed, fixed, stabilised;
-  auto run = run_once(*scenario, a, mode->second, true, a.out, closed, std::move(detector));
-  if (!run) return fail(cmd, run.error());
-  if (a.soak) return report_soak(*scenario, a, *run, closed);
   // Fixation turns the camera on purpose (toward the target); the stabilisation figure comes
   // from a run in stabilise mode (blank camera: that mode does not use vision).
   const bool fixating = mode->second == head::ControlMode::Fixate;
+  // Progress on stderr when it is a terminal (progress.h): the simulated frames of every run.
+  const double until_s = a.seconds > 0 ? a.seconds : scenario->first_frame_s + scenario->frames / scenario->fps;
+  const long run_frames = std::lround(until_s * scenario->fps);
+  Progress progress("sim-run", "frames", run_frames * (a.soak ? 1 : fixating ? 3 : 2));
+  RunMeasures closed, fixed, stabilised;
+  auto run = run_once(*scenario, a, mode->second, true, a.out, closed, {progress, 0, scenario->fps}, std::move(detector));
+  if (!run) return fail(cmd, run.error());
+  if (a.soak) {
+    progress.finish();
+    return report_soak(*scenario, a, *run, closed);
+  }
   if (fixating) {
-    auto st = run_once(*scenario, a, head::ControlMode::Stabilise, false, a.out, stabilised);
+    auto st = run_once(*scenario, a, head::ControlMode::Stabilise, false, a.out, stabilised, {progress, run_frames, scenario->fps});
     if (!st) return fail(cmd, "stabilise run: " + st.error());
   } else {
     stabilised = closed;
   }
   // The comparison: the same body motion with the head held still (no rendering needed).
-  auto held = run_once(*scenario, a, head::ControlMode::Hold, false, a.out, fixed);
+  auto held = run_once(*scenario, a, head::ControlMode::Hold, false, a.out, fixed,
+                       {progress, (fixating ? 2 : 1) * run_frames, scenario->fps});
   if (!held) return fail(cmd, "fixed-head run: " + held.error());
+  progress.finish(progress.total());
 
   const double success = closed.frames ? static_cast<double>(closed.succeeded) / closed.frames : 0.0;
   const double reduction =

@@ -26,6 +26,7 @@
 
 #include "command.h"
 #include "printable.h"
+#include "progress.h"
 #include "track_acquisition.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
@@ -272,7 +273,6 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> start_from_detection
   if (!found) return std::unexpected(found.error());
   if (!*found) return std::unique_ptr<TrackPredictor>{};
   seq.set_init({entry.frame, entry.t_s, **found, ""});
-  std::printf("frame %d: object detected; tracking from here\n", entry.frame);
   return make_track_predictor(seq, imu, offset);
 }
 
@@ -356,7 +356,9 @@ int run_track(const TrackArgs& args) {
   TrackCounts counts;
   std::size_t n = seq->frame_count();
   if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
+  Progress progress("track", "frames", static_cast<long>(n));  // on stderr when it is a terminal
   for (std::size_t i = 0; i < n; ++i) {
+    progress.update(static_cast<long>(i));
     auto frame = seq->read_frame(i);
     if (!frame) return fail(cmd, frame.error());
     if (auto ok = image.assign(*frame); !ok) return fail(cmd, "frame " + std::to_string(i) + ": " + ok.error());
@@ -370,6 +372,8 @@ int run_track(const TrackArgs& args) {
         per_frame.push_back({{"frame", entry.frame}, {"t_s", entry.t_s}, {"status", "searching"}});
         continue;
       }
+      progress.clear();  // the message on a line of its own when stdout is the same terminal
+      std::printf("frame %d: object detected; tracking from here\n", entry.frame);
       predictor = std::move(*started);
     }
     const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
@@ -405,6 +409,7 @@ int run_track(const TrackArgs& args) {
       if (auto ok = overlays.write(*frame, tracker, report, at_estimate, entry.frame, png); !ok) return fail(cmd, ok.error());
     }
   }
+  progress.finish(static_cast<long>(n));
   overlays.close();
 
   const std::string poses_path = (fs::path(args.out) / "poses.csv").string();

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include <unistd.h>
+#include "progress.h"
 
 namespace epichead::tools {
 
@@ -39,20 +39,16 @@ std::expected<std::unique_ptr<vision::Detector>, std::string> make_detector(cons
                                                                             const vision::Camera& camera,
                                                                             const DetectionArgs& args,
                                                                             const vision::ModelTrackerOptions& tracking) {
-  const bool tty = ::isatty(STDERR_FILENO) != 0;
-  int last_quarter = -1;
-  // On a terminal a running count; in a log a line per quarter.
-  const vision::Detector::Progress progress = [&](int done, int total) {
-    if (total <= 0) return;
-    if (tty) {
-      std::fprintf(stderr, "\repichead %s: building detection templates %d/%d", command.c_str(), done, total);
-      if (done == total) std::fputc('\n', stderr);
-    } else if (const int q = 4 * done / total; q != last_quarter) {
-      last_quarter = q;
-      std::fprintf(stderr, "epichead %s: building detection templates %d/%d\n", command.c_str(), done, total);
-    }
+  // Building the templates takes tens of seconds the first time: progress on stderr when it is a
+  // terminal (progress.h), nothing in a log. Read from the cache, the callback is never called.
+  const std::string label = "epichead " + command + ": building detection templates";
+  Progress shown(label.c_str(), "templates", 0);
+  const vision::Detector::Progress progress = [&shown](int done, int total) {
+    shown.set_total(total);
+    shown.update(done);
   };
   auto detector = vision::Detector::create(model, camera, args.options, tracking, args.no_cache ? "" : args.cache_dir, progress);
+  shown.finish();
   if (!detector) return detector;
   for (const auto& w : (*detector)->warnings()) std::fprintf(stderr, "epichead %s: warning: %s\n", command.c_str(), w.c_str());
   return detector;

@@ -4,7 +4,8 @@
 # scene (`epichead sim --seed N`: background, light, material, path, occluders, placement),
 # tracked by every mode with and without the IMU, and summarised as distributions.
 # Writes DIR/rows.tsv (one row per run) and DIR/section.md (what tools/results.sh puts first in
-# docs/results.md).
+# docs/results.md); each simulation's stderr goes to DIR/seq/<scenario>-<seed>.sim.log. On a
+# terminal, a progress line on stderr (sequences done, time taken, time left: tools/progress.sh).
 # Usage: tools/heldout.sh [--dev "1 2 3"] [--held "101 ... 110"] [--scenarios "a b"] [--frames N]
 #                         [--jobs J] [--out DIR]
 #   --dev, --held   seed lists (defaults: 1 2 3 and 101..112)
@@ -15,6 +16,8 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$here/build/bin/epichead"
+# shellcheck source=progress.sh
+. "$here/tools/progress.sh"
 
 # One scenario and seed: simulate, track every mode with and without the IMU, score. Rows:
 # scenario seed set mode imu success success_2cm_2deg rot_med_deg transl_med_mm nis_mean nis_within nis_count
@@ -26,7 +29,13 @@ one() {
   local seq="$out/seq/$scenario-$seed"
   if [[ ! -f "$seq/gt.csv" ]]; then
     rm -rf "$seq"
-    "$bin" sim "$scenario" --out "$seq" --seed "$seed" ${frames:+--frames "$frames"} > /dev/null
+    mkdir -p "$out/seq"
+    # Its stderr to a log beside the sequence: several run at once, and the terminal is the
+    # progress line's.
+    if ! "$bin" sim "$scenario" --out "$seq" --seed "$seed" ${frames:+--frames "$frames"} > /dev/null 2> "$seq.sim.log"; then
+      echo "heldout: sim failed on $scenario seed $seed: $(tail -1 "$seq.sim.log")" >&2
+      exit 1
+    fi
   fi
   local rows="$out/rows/$scenario-$seed.tsv"
   : > "$rows.part"
@@ -92,7 +101,7 @@ while (($#)); do
     --frames) frames="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "heldout: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -103,10 +112,22 @@ if [[ -z "$scenarios" ]]; then
 fi
 mkdir -p "$out/rows"
 rm -f "$out/rows/"*.tsv
-for s in $scenarios; do
-  for seed in $dev; do echo "$s $seed dev"; done
-  for seed in $held; do echo "$s $seed held"; done
-done | xargs -P "$jobs" -L 1 "$0" --one "$out" "${frames:-all}"
+jobs_list() {
+  for s in $scenarios; do
+    for seed in $dev; do echo "$s $seed dev"; done
+    for seed in $held; do echo "$s $seed held"; done
+  done
+}
+# Each sequence's "done" line, and the progress line under them (in the pipeline's last stage,
+# so that a failed run still fails the script through pipefail).
+jobs_list | xargs -P "$jobs" -L 1 "$0" --one "$out" "${frames:-all}" | {
+  progress_start heldout "$(jobs_list | wc -l)" sequences
+  while IFS= read -r line; do
+    progress_say "$line"
+    progress_step
+  done
+  progress_end
+}
 cat "$out/rows/"*.tsv > "$out/rows.tsv"
 "$here/tools/heldout_table.sh" "$out/rows.tsv" "$dev" "$held" > "$out/section.md"
 echo "heldout: wrote $out/section.md ($(wc -l < "$out/rows.tsv") runs)"

@@ -7,6 +7,7 @@
 
 #include "command.h"
 #include "printable.h"
+#include "progress.h"
 #include "epichead/firmware_iface/version.h"
 
 namespace epichead::tools {
@@ -21,7 +22,9 @@ CommandRegistration::CommandRegistration(std::string name, std::string summary, 
 }
 
 int fail(const std::string& command, const std::string& reason) {
-  // The reason holds file names and text from files: shown escaped (printable.h).
+  // The reason holds file names and text from files: shown escaped (printable.h). On a clean
+  // line: a progress line being drawn is wiped first.
+  Progress::clear_current();
   std::cerr << "epichead " << command << ": " << printable(reason) << "\n";
   return kRuntimeErrorExit;
 }

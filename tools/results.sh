@@ -13,8 +13,12 @@
 #   --heldout-dir DIR  take the held-out section from an earlier `tools/heldout.sh --out DIR` run
 #   --no-visp    do not install libvisp-dev for ViSP's rows
 # Needs jq. ViSP's columns need libvisp-dev (the comparison program builds only with it).
+# On a terminal, a progress line on stderr (tracker runs done, time taken, time left:
+# tools/progress.sh); the held-out evaluation shows its own first.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=progress.sh
+. "$here/tools/progress.sh"
 frames=""
 out="$here/out/results"
 sweep=1
@@ -31,7 +35,7 @@ while (($#)); do
     --no-heldout) heldout=0; shift ;;
     --heldout-dir) heldout_dir="$2"; shift 2 ;;
     --no-visp) visp_install=0; shift ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "results: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -99,11 +103,13 @@ track_all() {
     for imu in "${imus[@]}"; do
       local dir="$out/$label/$mode-imu-$imu"
       mkdir -p "$out/$label"
-      echo "results: $label $mode imu $imu"
+      progress_say "results: $label $mode imu $imu"
       # The IMU clock offset is estimated by the tracker (--imu-time-offset-s auto, the default).
       if ! "$bin" track "$seq" --out "$dir" --mode "$mode" --imu "$imu" --every 50 \
           > "$dir.log" 2>&1; then
+        progress_clear
         echo "results: track failed on $label ($mode, imu $imu): $(tail -1 "$dir.log")" >&2
+        progress_step
         continue
       fi
       "$bin" score "$seq" "$dir/poses.csv" --json "$@" > "$dir/score.json"
@@ -119,27 +125,45 @@ track_all() {
         fi
       done
       row "$label" "epichead $mode" "$imu" "$dir" "$dir/score.json" "$(spread "${rates[@]}")"
+      progress_step
     done
   done
   if [[ -x "$visp" ]]; then
     for vmode in edges edges+klt; do
       local dir="$out/$label/visp-$vmode"
       mkdir -p "$out/$label"
-      echo "results: $label ViSP $vmode"
+      progress_say "results: $label ViSP $vmode"
       if "$visp" "$seq" --out "$dir" --mode "$vmode" --overlay-every 50 > "$dir.log" 2>&1; then
         "$bin" score "$seq" "$dir/poses.csv" --json "$@" > "$dir/score.json"
         row "$label" "ViSP $vmode" "off" "$dir" "$dir/score.json" "–"
       else
+        progress_clear
         echo "results: ViSP failed on $label ($vmode): $(tail -1 "$dir.log")" >&2
       fi
+      progress_step
     done
   fi
 }
 
-for scenario in mockup_walk box_clutter office_pan lampshade can bowl; do
+# Progress: one step per tracker and mode on a sequence (with its extra RANSAC seeds), and the
+# line-selection runs. A simulated sequence has imu.csv (tracked with and without it); the real
+# videos are checked.
+scenarios=(mockup_walk box_clutter office_pan lampshade can bowl)
+runs_per_imu=3
+visp_runs=0
+[[ -x "$visp" ]] && visp_runs=2
+total=$(( ${#scenarios[@]} * (2 * runs_per_imu + visp_runs) + 3 ))
+for real in teabox teabox_left; do
+  imus=1
+  [[ -f "$data/$real/imu.csv" ]] && imus=2
+  total=$((total + imus * runs_per_imu + visp_runs))
+done
+progress_start results "$total" runs
+for scenario in "${scenarios[@]}"; do
   seq="$out/seq/$scenario"
   if [[ ! -f "$seq/gt.csv" ]]; then
-    echo "results: simulating $scenario"
+    progress_say "results: simulating $scenario"
+    progress_clear  # sim draws its own progress line (on a terminal)
     rm -rf "$seq"
     "$bin" sim "$scenario" --out "$seq" ${frames:+--frames "$frames"} > /dev/null
   fi
@@ -178,7 +202,9 @@ for mode in gradient epic epic+validation; do
     "$(jq -r '.line_selection.right_rate * 100' "$dir/score.json")" "$(jq -r '.line_selection.selections' "$dir/score.json")" \
     "$(jq -r '.line_selection.crowded_right_rate * 100' "$dir/score.json")" \
     "$(jq -r '.line_selection.crowded_selections' "$dir/score.json")" >> "$lines_section"
+  progress_step
 done
+progress_end
 # The overlay frame (a multiple of 5) where validation has the most more crowded edges right.
 pick=$(jq -n --slurpfile e "$out/lines/epic/score.json" --slurpfile v "$out/lines/epic+validation/score.json" '
   [$v[0].line_selection.crowded_right_by_frame | to_entries[] | select((.key | tonumber) % 5 == 0)

@@ -1,5 +1,6 @@
 #include "run_config.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -59,7 +60,67 @@ const GainField* find_gain(const std::string& key) {
   return nullptr;
 }
 
+std::string json_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
+std::string json_string(const std::string& s) { return nlohmann::json(s).dump(); }
+
+// The first key of `j` (an object) that run_config_keys() does not list, as "section.key", or
+// nothing. A section that is not an object is left to the reader, which says so.
+std::optional<std::string> unknown_key(const nlohmann::json& j) {
+  const std::vector<RunConfigKey> keys = run_config_keys(head::HeadControllerOptions{});
+  auto known = [&](const std::string& name) {
+    return std::any_of(keys.begin(), keys.end(), [&](const RunConfigKey& k) { return k.name == name; });
+  };
+  auto section = [&](const std::string& name) {
+    return std::any_of(keys.begin(), keys.end(), [&](const RunConfigKey& k) { return k.name.starts_with(name + "."); });
+  };
+  for (const auto& [key, value] : j.items()) {
+    if (!section(key)) {
+      if (!known(key)) return key;
+      continue;
+    }
+    if (!value.is_object()) continue;
+    for (const auto& [sub, unused] : value.items())
+      if (!known(key + "." + sub)) return key + "." + sub;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::vector<RunConfigKey> run_config_keys(const head::HeadControllerOptions& controller) {
+  const RunConfig d;  // the defaults of every key but the gains, from the option types
+  std::vector<RunConfigKey> keys{
+      {"model", "string", "required"},
+      {"camera_calibration", "string", "required"},
+      {"init_pose", "string", "none"},
+      {"template_cache", "string", "none"},
+      {"reacquire", "boolean", d.reacquire ? "true" : "false"},
+      {"mode", "string", json_string(d.mode)},
+      {"out", "string", json_string(d.out)},
+      {"camera.device", "string", json_string(d.camera.device)},
+      {"camera.width", "integer", std::to_string(d.camera.width)},
+      {"camera.height", "integer", std::to_string(d.camera.height)},
+      {"camera.fps", "number", json_number(d.camera.frame_rate_hz)},
+      {"can.interface", "string", json_string(d.can.interface)},
+      {"can.receive_buffer_bytes", "integer", std::to_string(d.can.receive_buffer_bytes)},
+      {"can.time_sync_max_round_trip_ms", "number", json_number(d.time_sync_max_round_trip_s * 1e3)},
+      {"head.pan_backlash_rad", "number", json_number(d.backlash.pan_rad)},
+      {"head.tilt_backlash_rad", "number", json_number(d.backlash.tilt_rad)},
+      {"threads.control_cpu", "integer", std::to_string(d.threads.control_cpu)},
+      {"threads.vision_cpu", "integer", std::to_string(d.threads.vision_cpu)},
+      {"threads.control_priority", "integer", std::to_string(d.threads.control_priority)},
+      {"threads.vision_priority", "integer", std::to_string(d.threads.vision_priority)},
+      {"threads.lock_memory", "boolean", d.threads.lock_memory ? "true" : "false"},
+  };
+  for (const GainField& f : kGains)
+    keys.push_back({std::string("controller.") + f.key, "number", json_number(controller.*f.target)});
+  return keys;
+}
 
 head::HeadControllerOptions controller_options(const RunConfig& config, head::HeadControllerOptions options) {
   options.backlash = config.backlash;
@@ -106,8 +167,9 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "is reported in summary.json and the run goes on with normal scheduling (docs/head.md).\n"
          "Without init_pose the object is detected from the model (templates cached in template_cache;\n"
          "by default $EPICHEAD_CACHE_DIR, else $XDG_CACHE_HOME/epichead, else ~/.cache/epichead;\n"
-         "built once with progress on stderr); with reacquire it is detected again after a loss\n"
-         "(docs/detection.md). reacquire false with an init_pose builds no templates.\n";
+         "built once, with progress when stderr is a terminal); with reacquire it is detected again after a loss\n"
+         "(docs/detection.md). reacquire false with an init_pose builds no templates.\n"
+         "A key not listed here is an error. Every key with its unit and meaning: docs/run_config.md.\n";
 }
 
 std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
@@ -125,6 +187,11 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
   try {
     for (const char* key : {"model", "camera_calibration"})
       if (!j.contains(key) || !j[key].is_string()) return std::unexpected(path + ": missing string field '" + key + "'");
+    // Before any default is taken: a misspelt key would otherwise leave its default in force unseen.
+    if (const auto key = unknown_key(j))
+      return std::unexpected(path + ": unknown key " +
+                             nlohmann::json(*key).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                             " (docs/run_config.md lists the keys)");
     c.model = resolve(j["model"].get<std::string>());
     c.calibration = resolve(j["camera_calibration"].get<std::string>());
     // Without a start pose the loop detects the object (vision/detector.h).

@@ -166,6 +166,18 @@ def scenario(out):
         write(out, "scenario", p.stem, p.read_bytes())
 
 
+RUN_CONFIG_EVERY_KEY = """{ "model": "m.cao", "camera_calibration": "c.yaml", "init_pose": "i.csv", "template_cache": "t",
+  "reacquire": true, "mode": "hold", "out": "o",
+  "camera": { "device": "/dev/video1", "width": 1280, "height": 720, "fps": 30 },
+  "can": { "interface": "vcan0", "receive_buffer_bytes": 0, "time_sync_max_round_trip_ms": 45 },
+  "head": { "pan_backlash_rad": 0.002, "tilt_backlash_rad": 0.001 },
+  "threads": { "control_cpu": 1, "vision_cpu": 0, "control_priority": 80, "vision_priority": 10, "lock_memory": true },
+  "controller": { "stabilise_gain_per_s": 60, "fixate_gain_per_s": 5, "fixate_max_rate_radps": 1.5,
+                  "target_rate_filter_s": 0.15, "target_rate_max_radps": 1, "hold_gain_per_s": 10,
+                  "hold_max_rate_radps": 2, "rate_lead_s": 0.006, "rate_lead_filter_s": 0.004 } }
+"""
+
+
 def run_config(out):
     write(out, "run_config", "full", """{ "model": "teabox/model.cao", "camera_calibration": "teabox/camera.yaml",
   "init_pose": "teabox/init.csv",
@@ -176,6 +188,10 @@ def run_config(out):
 """)
     write(out, "run_config", "minimal", '{"model":"m.cao","camera_calibration":"/abs/c.yaml","init_pose":"i.csv"}')
     write(out, "run_config", "detect", '{"model":"m.cao","camera_calibration":"c.yaml","reacquire":false,"template_cache":"t"}')
+    # Every key docs/run_config.md lists, and misspelt keys (an error naming the key).
+    write(out, "run_config", "every_key", RUN_CONFIG_EVERY_KEY)
+    write(out, "run_config", "unknown_key", '{"model":"m.cao","camera_calibration":"c.yaml","camera":{"widht":1280}}')
+    write(out, "run_config", "unknown_top_key", '{"model":"m.cao","camera_calibration":"c.yaml","reaquire":false}')
 
 
 def template_record(view, roll, dist, distance_m, dx, dy, levels):

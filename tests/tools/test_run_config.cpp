@@ -1,9 +1,16 @@
 // The `epichead run --config` reader: the controller's gains come from the file, a gain the
-// controller does not have or out of its range is an error naming it, and --help lists them.
+// controller does not have or out of its range is an error naming it, any other unknown key too,
+// --help lists them, and docs/run_config.md documents exactly the keys the reader knows.
 #include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
+#include "epichead/head/onboard_loop.h"
 #include "run_config.h"
 
 namespace {
@@ -113,4 +120,84 @@ TEST_CASE("run config: without init_pose the object is detected, reacquire is a 
   const auto bad_path = read_run_config(dir.write("d.json", R"({ "model": "m.cao", "camera_calibration": "c.yaml", "init_pose": 3 })"));
   REQUIRE_FALSE(bad_path);
   CHECK(bad_path.error().find("'init_pose' must be a string") != std::string::npos);
+}
+
+namespace {
+
+// The rows of docs/run_config.md's key table: key, type, unit, default, meaning (backticks taken
+// off the key and the default).
+std::vector<std::vector<std::string>> documented_keys() {
+  std::vector<std::vector<std::string>> rows;
+  for (const std::string& line : epichead::testing::lines_of(epichead::testing::slurp(EPICHEAD_SOURCE_DIR "/docs/run_config.md"))) {
+    if (!line.starts_with("| `")) continue;
+    std::vector<std::string> cells;
+    std::size_t start = 1;
+    for (std::size_t bar; (bar = line.find(" | ", start)) != std::string::npos; start = bar + 3)
+      cells.push_back(line.substr(start, bar - start));
+    cells.push_back(line.substr(start, line.size() - start - 2));  // the last, before " |"
+    for (std::string& cell : cells) {
+      while (!cell.empty() && cell.front() == ' ') cell.erase(0, 1);
+      if (cell.size() >= 2 && cell.front() == '`' && cell.back() == '`') cell = cell.substr(1, cell.size() - 2);
+    }
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("docs/run_config.md lists exactly the keys the reader knows, with their types and defaults") {
+  const auto rows = documented_keys();
+  const auto keys = epichead::tools::run_config_keys(epichead::head::OnboardOptions{}.controller);
+  REQUIRE(rows.size() == keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    INFO("row " << i + 1 << ": " << keys[i].name);
+    REQUIRE(rows[i].size() == 5);
+    CHECK(rows[i][0] == keys[i].name);
+    CHECK(rows[i][1] == keys[i].type);
+    CHECK(rows[i][3] == keys[i].default_json);
+    CHECK_FALSE(rows[i][2].empty());  // a unit, or '–'
+    CHECK(rows[i][4].size() > 10);    // a meaning
+  }
+  // `run --help` shows the same defaults for the controller as the loop uses.
+  CHECK(epichead::head::OnboardOptions{}.controller.stabilise_gain_per_s ==
+        epichead::head::HeadControllerOptions{}.stabilise_gain_per_s);
+}
+
+TEST_CASE("run config: a file giving every documented key is read") {
+  TempDir dir;
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& key : epichead::tools::run_config_keys(epichead::head::HeadControllerOptions{})) {
+    nlohmann::json value;
+    if (key.default_json == "required" || key.default_json == "none") value = "some/file";
+    else value = nlohmann::json::parse(key.default_json);
+    const std::size_t dot = key.name.find('.');
+    if (dot == std::string::npos) j[key.name] = value;
+    else j[key.name.substr(0, dot)][key.name.substr(dot + 1)] = value;
+  }
+  const auto c = read_run_config(dir.write("all.json", j.dump()));
+  INFO((c ? std::string() : c.error()));
+  CHECK(c);
+}
+
+TEST_CASE("run config: an unknown key, at the top or in a section, is an error naming the file and the key") {
+  TempDir dir;
+  const std::string path = write_config(dir, R"("camera": { "device": "/dev/video2", "widht": 1280 })");
+  const auto typo = read_run_config(path);
+  REQUIRE_FALSE(typo);
+  CHECK(typo.error().starts_with(path + ": "));
+  CHECK(typo.error().find("unknown key \"camera.widht\"") != std::string::npos);
+  const auto top = read_run_config(write_config(dir, R"("reaquire": false)"));
+  REQUIRE_FALSE(top);
+  CHECK(top.error().find("unknown key \"reaquire\"") != std::string::npos);
+  const auto can = read_run_config(write_config(dir, R"("can": { "interface": "can1", "bitrate": 1000000 })"));
+  REQUIRE_FALSE(can);
+  CHECK(can.error().find("unknown key \"can.bitrate\"") != std::string::npos);
+  const auto head = read_run_config(write_config(dir, R"("head": { "backlash_rad": 0.01 })"));
+  REQUIRE_FALSE(head);
+  CHECK(head.error().find("unknown key \"head.backlash_rad\"") != std::string::npos);
+  // A key with a line break in it stays on one line.
+  const auto newline = read_run_config(write_config(dir, R"("mo\nde": "hold")"));
+  REQUIRE_FALSE(newline);
+  CHECK(newline.error().find('\n') == std::string::npos);
 }

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/readme_columns.h"
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
 
@@ -186,4 +187,20 @@ TEST_CASE("sim-run leaves the frames a cover board hides the object in out of th
   CHECK(hidden <= 17);
   CHECK(j["frames"].get<int>() > 20);
   CHECK(r.out.find("frames with the object hidden by a cover left out") != std::string::npos);
+}
+
+TEST_CASE("timeline.csv's header is the list of columns README.md documents, each named with its unit") {
+  TempDir dir("sim_run_timeline");
+  const auto r = run_epichead(dir, "sim-run mockup_walk --out '" + dir.str() +
+                                       "/out' --seconds 0.3 --mode stabilise --downscale 8 --every 0 --settle-s 0");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto header = lines_of(slurp(dir / "out/timeline.csv")).at(0);
+  const auto documented = epichead::testing::documented_columns(EPICHEAD_SOURCE_DIR "/README.md", "**timeline.csv**");
+  CHECK(header == epichead::testing::joined(documented));
+  // SI or named with the unit: time in s, the rest with a unit suffix.
+  for (const std::string& column : documented) {
+    INFO(column);
+    CHECK((column.ends_with("_s") || column.ends_with("_deg") || column.ends_with("_degps") || column.ends_with("_px")));
+  }
 }

@@ -1,12 +1,15 @@
 // Pose CSVs (init.csv, gt.csv, poses.csv): tolerant reading, file:line errors, exact round trips.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <unistd.h>
 
 #include "epichead/vision/offline/stamped_pose.h"
+#include "common/readme_columns.h"
 #include "common/temp_dir.h"
 
 using epichead::vision::make_pose;
@@ -151,4 +154,29 @@ TEST_CASE("write_pose_csv writes the status column when a pose has a status") {
   poses[0].status = "a,b";
   CHECK_FALSE(write_pose_csv(path, poses).has_value());
   CHECK_FALSE(write_pose_csv((dir.path / "no/such/dir.csv").string(), poses).has_value());
+}
+
+TEST_CASE("pose CSVs are written as README.md documents them: its columns, cam_T_obj, qw first, unit quaternion, qw >= 0") {
+  TempDir dir;
+  const std::string path = (dir.path / "poses.csv").string();
+  // A turn of 300 deg about x: Eigen's quaternion for it may come out with w < 0.
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(300.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+  REQUIRE(write_pose_csv(path, {{7, 0.25, make_pose({0.1, -0.2, 0.9}, q), "tracked"}}));
+  std::ifstream in(path);
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  const auto documented = epichead::testing::documented_columns(EPICHEAD_SOURCE_DIR "/README.md", "**Pose CSVs**");
+  CHECK(header == epichead::testing::joined(documented));
+  double v[9];
+  char status[16] = {};
+  REQUIRE(std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%15s", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
+                      &v[7], &v[8], status) == 10);
+  CHECK(v[2] == Approx(0.1));  // the object's origin in the camera frame, m
+  CHECK(v[4] == Approx(0.9));
+  const Eigen::Quaterniond written(v[5], v[6], v[7], v[8]);  // w, x, y, z
+  CHECK(written.w() >= 0);
+  CHECK(written.norm() == Approx(1.0).epsilon(1e-6));
+  CHECK(written.angularDistance(q) < 1e-6);
+  CHECK(std::string(status) == "tracked");
 }
