@@ -1,7 +1,8 @@
 // Benchmarks camera_project_*, camera_jacobian_* and camera_unproject_*: the camera model's
 // per-point work (projection of model points and edgels, the pose estimator's Jacobian, the
 // inverse for rays), 256 points across the image per iteration. _k5 is OpenCV's default model
-// (k1 k2 p1 p2 k3), the one most calibrations have.
+// (k1 k2 p1 p2 k3), the one most calibrations have; _k14 has every term of cv::projectPoints
+// (rational k4..k6, thin prism s1..s4, sensor tilt).
 #include <memory>
 #include <vector>
 
@@ -64,8 +65,16 @@ void add(const char* name, Camera (*camera)()) {
 // A typical webcam calibration: barrel distortion and small tangential terms.
 Camera k5_camera() { return Camera(640, 480, {600, 602, 321.5, 238.25}, Distortion{-0.28, 0.09, 0.001, -0.0007, -0.012}); }
 
+// A wide-angle lens calibrated with CALIB_RATIONAL_MODEL | CALIB_THIN_PRISM_MODEL | CALIB_TILTED_MODEL.
+Camera k14_camera() {
+  return Camera(640, 480, {520, 523.5, 318.25, 243.5},
+                Distortion{0.82, 0.05, 0.0012, -0.0006, 0.021, 1.12, 0.15, 0.082, 0.0021, -0.0004, -0.0015, 0.0003,
+                           0.012, -0.021});
+}
+
 const bool registered = [] {
   add("k5", k5_camera);
+  add("k14", k14_camera);
   return true;
 }();
 
