@@ -202,6 +202,48 @@ TEST_CASE("calibrations OpenCV wrote with 8, 12 and 14 coefficients load, projec
   }
 }
 
+TEST_CASE("a calibration cv::calibrateCamera made with the rational, thin-prism and tilted models loads and projects as OpenCV") {
+  // A chessboard session (9 x 6, 25 mm, 14 views) through the 14-coefficient lens.
+  std::vector<cv::Point3f> corners;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 9; ++c) corners.emplace_back(static_cast<float>((c - 4) * 0.025), static_cast<float>((r - 2.5) * 0.025), 0.f);
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image;
+  for (int v = 0; v < 14; ++v) {
+    const double a = 2 * M_PI * v / 14;
+    std::vector<cv::Point2f> seen;
+    cv::projectPoints(corners, cv::Vec3d(0.5 * std::cos(a), 0.5 * std::sin(a), 0.2 * std::sin(2 * a)),
+                      cv::Vec3d(0.1 * std::cos(a), 0.07 * std::sin(a), 0.25 + 0.04 * (v % 3)), opencv_K(),
+                      opencv_D(kTilted, 14), seen);
+    object.push_back(corners);
+    image.push_back(seen);
+  }
+  cv::Mat K, D;
+  std::vector<cv::Mat> rvecs, tvecs;
+  const double rms = cv::calibrateCamera(object, image, cv::Size(640, 480), K, D, rvecs, tvecs,
+                                         cv::CALIB_RATIONAL_MODEL | cv::CALIB_THIN_PRISM_MODEL | cv::CALIB_TILTED_MODEL);
+  INFO("rms " << rms << " px, D " << D);
+  REQUIRE(D.total() == 14);
+  epichead::testing::TempDir dir("epichead_test_camera_rational");
+  const std::string path = (dir.path / "calibration.yml").string();
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << K << "distortion_coefficients" << D;
+    fs << "avg_reprojection_error" << rms;
+  }
+  auto cam = Camera::load(path);
+  REQUIRE(cam);
+  const std::vector<cv::Point3d> points = points_over_image();
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, expected);
+  double worst = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d px = cam->project({points[i].x, points[i].y, points[i].z});
+    worst = std::max(worst, (px - Eigen::Vector2d(expected[i].x, expected[i].y)).norm());
+  }
+  CHECK(worst < 1e-9);
+}
+
 TEST_CASE("save writes the shortest of OpenCV's lengths that holds the non-zero coefficients") {
   epichead::testing::TempDir dir("epichead_test_camera_rational");
   const auto saved_length = [&](const Distortion& d) {
