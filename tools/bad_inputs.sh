@@ -80,6 +80,8 @@ make_inputs() {
   seq cam_emptykey && camera_yaml '{ :3 }' 480 > cam_emptykey/camera.yaml
   seq cam_fisheye && camera_yaml 640 480 $'fisheye_model: 1\n' 5 '0.1, 0.01, 0., 0., 0.' > cam_fisheye/camera.yaml
   seq cam_ros && camera_yaml 640 480 $'distortion_model: rational_polynomial\n' > cam_ros/camera.yaml
+  seq cam_ros_model && camera_yaml 640 480 $'distortion_model: fov\n' > cam_ros_model/camera.yaml
+  seq cam_nine && camera_yaml 640 480 '' 9 '0., 0., 0., 0., 0., 0., 0., 0., 0.' > cam_nine/camera.yaml
   seq cam_small && camera_yaml 320 240 > cam_small/camera.yaml
   seq cam_focal && camera_yaml 640 480 | sed 's/839.2, 0., 325.0/-839.2, 0., 325.0/' > cam_focal/c && mv cam_focal/c cam_focal/camera.yaml
   seq cam_big && { camera_yaml 640 480; head -c 1100000 /dev/zero | tr '\0' '#'; } > cam_big/camera.yaml
@@ -192,7 +194,9 @@ O="--out out --no-video --every 0 --frames 2"
   run 1 "camera.yaml typo in rows (OpenCV would ask for 48 GB)" $T cam_typo $O
   run 1 "camera.yaml empty key (OpenCV throws std::length_error)" $T cam_emptykey $O
   run 1 "camera.yaml fisheye_model: 1 with 5 coefficients" $T cam_fisheye $O
-  run 1 "camera.yaml ROS distortion_model: rational_polynomial" $T cam_ros $O
+  run 1 "camera.yaml ROS distortion_model: rational_polynomial with 5 coefficients" $T cam_ros $O
+  run 1 "camera.yaml ROS distortion_model: fov (not supported)" $T cam_ros_model $O
+  run 1 "camera.yaml 9 distortion coefficients (not an OpenCV model)" $T cam_nine $O
   run 1 "camera.yaml 320x240 for 640x480 video" $T cam_small $O
   run 1 "camera.yaml negative focal length" $T cam_focal $O
   run 1 "camera.yaml larger than 1 MiB" $T cam_big $O

@@ -48,6 +48,22 @@ def camera(out):
           "image_width: 640\nimage_height: 480\ncamera_name: head_camera\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
           "  data: [500.0, 0.0, 320.5, 0.0, 505.0, 240.25, 0.0, 0.0, 1.0]\ndistortion_model: plumb_bob\n"
           "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.1, 0.01, 0.001, 0.002, 0.0005]\n")
+    # ROS's rational_polynomial: k1 k2 p1 p2 k3 k4 k5 k6.
+    write(out, "camera_yaml", "ros_rational",
+          "image_width: 640\nimage_height: 480\ncamera_name: head_camera\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+          "  data: [520.0, 0.0, 318.25, 0.0, 523.5, 243.5, 0.0, 0.0, 1.0]\ndistortion_model: rational_polynomial\n"
+          "distortion_coefficients:\n  rows: 1\n  cols: 8\n"
+          "  data: [0.82, 0.05, 0.0012, -0.0006, 0.021, 1.12, 0.15, 0.082]\n")
+    # OpenCV's rational (8), thin-prism (12) and tilted (14) models, as its calibration sample
+    # writes them: a column of coefficients.
+    coefficients = [0.82, 0.05, 0.0012, -0.0006, 0.021, 1.12, 0.15, 0.082, 0.0021, -0.0004, -0.0015, 0.0003, 0.012, -0.021]
+    for n in (8, 12, 14):
+        write(out, "camera_yaml", f"opencv_k{n}",
+              "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nflags: 16384\n"
+              "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+              "   data: [ 520., 0., 318.25, 0., 523.5, 243.5, 0., 0., 1. ]\n"
+              f"distortion_coefficients: !!opencv-matrix\n   rows: {n}\n   cols: 1\n   dt: d\n"
+              "   data: [ " + ", ".join(repr(c) for c in coefficients[:n]) + " ]\n")
 
 
 def csvs(out):

@@ -95,8 +95,20 @@ TEST_CASE("A calibration model the reader does not support is an error, never re
   // ROS's equidistant is the fisheye model: k1..k4, not the five of this file.
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: equidistant\nimage_width: 160")),
              Catch::Contains("must have 4 distortion_coefficients (k1..k4), got 5"));
+  // ROS's rational_polynomial is k1..k6 with p1 p2: eight, not five.
   CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: rational_polynomial\nimage_width: 160")),
-             Catch::Contains("distortion_model 'rational_polynomial' is not supported"));
+             Catch::Contains("distortion_model rational_polynomial has 8 distortion_coefficients (k1 k2 p1 p2 k3 k4 k5 k6), got 5"));
+  CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: fov\nimage_width: 160")),
+             Catch::Contains("distortion_model 'fov' is not supported"));
+  CHECK_THAT(load_error(edited("image_width: 160", "distortion_model: [ plumb_bob ]\nimage_width: 160")),
+             Catch::Contains("distortion_model '(not a name)' is not supported"));
+  // Counts OpenCV's calibration never writes, and a NaN among eight.
+  CHECK_THAT(load_error(edited("cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]", "cols: 9\n   dt: d\n   data: [ 0., 0., 0., 0., 0., 0., 0., 0., 0. ]")),
+             Catch::Contains("distortion_coefficients must have 0, 4, 5, 8, 12 or 14 values (OpenCV's models), got 9"));
+  CHECK_THAT(load_error(edited("cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]", "cols: 8\n   dt: d\n   data: [ 0., 0., 0., 0., 0., .nan, 0., 0. ]")),
+             Catch::Contains("distortion_coefficients has a non-finite value at (0,5)"));
+  CHECK_THAT(load_error(edited("cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]", "cols: 14\n   dt: d\n   data: [ 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0. ]")),
+             Catch::Contains("distortion_coefficients.data has 13 values, rows x cols is 1x14"));
   epichead::testing::TempDir dir("epichead_test_camera_bad");
   CHECK(Camera::load(dir.write("a.yaml", edited("image_width: 160", "fisheye_model: 0\nimage_width: 160"))).has_value());
   CHECK(Camera::load(dir.write("b.yaml", edited("image_width: 160", "distortion_model: plumb_bob\nimage_width: 160"))).has_value());

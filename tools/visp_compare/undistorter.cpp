@@ -16,7 +16,8 @@ Undistorter::Undistorter(const vision::Camera& camera) : camera_(camera) {
     const cv::Vec4d dist(d[0], d[1], d[2], d[3]);
     cv::fisheye::initUndistortRectifyMap(K, dist, cv::Matx33d::eye(), K, size, CV_16SC2, map1_, map2_);
   } else {
-    const cv::Vec<double, 5> dist(d[0], d[1], d[2], d[3], d[4]);
+    // All 14 of OpenCV's coefficients (zeros beyond a shorter calibration change nothing).
+    const cv::Mat dist(1, static_cast<int>(d.size()), CV_64F, const_cast<double*>(d.data()));
     cv::initUndistortRectifyMap(K, dist, cv::noArray(), K, size, CV_16SC2, map1_, map2_);
   }
 }

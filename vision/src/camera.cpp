@@ -108,23 +108,28 @@ bool is_ros_camera_info(std::string_view text) {
   return has_key("camera_matrix:") && has_key("distortion_model:");
 }
 
-// The lens model the file names (ROS's distortion_model, or cv::fisheye's fisheye_model). A
-// model this reader does not know is an error: read as another, it would project pixels off
-// without a word.
-std::expected<LensModel, std::string> read_lens(const cv::FileStorage& fs, const std::string& path) {
+// The lens model the file names (ROS's distortion_model, or cv::fisheye's fisheye_model), and
+// the ROS name, which also fixes the number of coefficients. A model this reader does not know
+// is an error: read as another, it would project pixels off without a word.
+struct DeclaredLens {
+  LensModel model = LensModel::Pinhole;
+  std::string ros_name;  // empty in an OpenCV file
+};
+std::expected<DeclaredLens, std::string> read_lens(const cv::FileStorage& fs, const std::string& path) {
   const cv::FileNode model = fs["distortion_model"];  // ROS camera_info
   if (!model.empty() && !model.isNone()) {
     const std::string name = model.isString() ? model.string() : std::string("(not a name)");
-    if (name == "plumb_bob") return LensModel::Pinhole;
-    if (name == "equidistant") return LensModel::Fisheye;  // ROS's name for cv::fisheye's model
+    if (name == "plumb_bob" || name == "rational_polynomial") return DeclaredLens{LensModel::Pinhole, name};
+    if (name == "equidistant") return DeclaredLens{LensModel::Fisheye, name};  // ROS's name for cv::fisheye's model
     return Error(path + ": distortion_model '" + name +
-                 "' is not supported: only plumb_bob (k1 k2 p1 p2 k3) and equidistant (k1..k4)");
+                 "' is not supported: only plumb_bob (k1 k2 p1 p2 k3), rational_polynomial (k1 k2 p1 p2 k3 k4 k5 k6) "
+                 "and equidistant (k1..k4)");
   }
   const cv::FileNode fisheye = fs["fisheye_model"];  // what cv::fisheye calibration writes: 1
-  if (fisheye.empty() || fisheye.isNone()) return LensModel::Pinhole;
+  if (fisheye.empty() || fisheye.isNone()) return DeclaredLens{};
   if (!fisheye.isInt() || (static_cast<int>(fisheye) != 0 && static_cast<int>(fisheye) != 1))
     return Error(path + ": fisheye_model must be 0 (pinhole) or 1 (cv::fisheye's equidistant model)");
-  return static_cast<int>(fisheye) == 1 ? LensModel::Fisheye : LensModel::Pinhole;
+  return DeclaredLens{static_cast<int>(fisheye) == 1 ? LensModel::Fisheye : LensModel::Pinhole, {}};
 }
 
 std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const std::string& path, bool ros) {
@@ -155,17 +160,38 @@ std::expected<Camera, std::string> load_from(const cv::FileStorage& fs, const st
     if (d->rows != 1 && d->cols != 1)
       return Error(path + ": distortion_coefficients must be a row or column vector, got " + shape(*d));
     const int n = static_cast<int>(d->total());
-    if (*lens == LensModel::Fisheye && n != 4)
+    if (lens->model == LensModel::Fisheye && n != 4)
       return Error(path + ": a fisheye calibration (fisheye_model: 1, distortion_model: equidistant) must have 4 "
                           "distortion_coefficients (k1..k4), got " + std::to_string(n));
-    if (n == 8 || n == 12 || n == 14)
-      return Error(path + ": distortion_coefficients has " + std::to_string(n) +
-                   " values (rational / thin-prism / tilted model); only k1 k2 p1 p2 k3 (4 or 5 values) is supported");
-    if (n != 4 && n != 5)
-      return Error(path + ": distortion_coefficients must have 0, 4 or 5 values, got " + std::to_string(n));
+    if (lens->ros_name == "plumb_bob" && n != 4 && n != 5)
+      return Error(path + ": distortion_model plumb_bob has 5 distortion_coefficients (k1 k2 p1 p2 k3), got " +
+                   std::to_string(n) + (n == 8 ? " (8 is rational_polynomial)" : ""));
+    if (lens->ros_name == "rational_polynomial" && n != 8)
+      return Error(path + ": distortion_model rational_polynomial has 8 distortion_coefficients (k1 k2 p1 p2 k3 k4 k5 "
+                          "k6), got " + std::to_string(n));
+    if (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
+      return Error(path + ": distortion_coefficients must have 0, 4, 5, 8, 12 or 14 values (OpenCV's models), got " +
+                   std::to_string(n));
     for (int i = 0; i < n; ++i) dist[static_cast<std::size_t>(i)] = d->at<double>(i);
+  } else if (lens->ros_name == "rational_polynomial") {
+    return Error(path + ": distortion_model rational_polynomial has 8 distortion_coefficients (k1 k2 p1 p2 k3 k4 k5 "
+                        "k6), got none");
   }
-  return Camera(*width, *height, in, dist, *lens);
+  return Camera(*width, *height, in, dist, lens->model);
+}
+
+// OpenCV's tilted-sensor projection (computeTiltProjectionMatrix in calib3d's
+// distortion_model.hpp): the sensor rotated by taux about x, then tauy about y, and the image
+// projected back along the optical axis onto the tilted plane.
+Eigen::Matrix3d tilt_projection(double taux_rad, double tauy_rad) {
+  const double cx = std::cos(taux_rad), sx = std::sin(taux_rad), cy = std::cos(tauy_rad), sy = std::sin(tauy_rad);
+  Eigen::Matrix3d rot_x, rot_y;
+  rot_x << 1, 0, 0, 0, cx, sx, 0, -sx, cx;
+  rot_y << cy, 0, -sy, 0, 1, 0, sy, 0, cy;
+  const Eigen::Matrix3d rot_xy = rot_y * rot_x;
+  Eigen::Matrix3d proj_z;
+  proj_z << rot_xy(2, 2), 0, -rot_xy(0, 2), 0, rot_xy(2, 2), -rot_xy(1, 2), 0, 0, 1;
+  return proj_z * rot_xy;
 }
 
 }  // namespace
@@ -178,11 +204,19 @@ Camera::Camera(int width_px, int height_px, const Intrinsics& k, const Distortio
   if (!std::isfinite(k.cx_px) || !std::isfinite(k.cy_px)) throw std::invalid_argument("Camera: principal point must be finite");
   for (double c : dist_)
     if (!std::isfinite(c)) throw std::invalid_argument("Camera: distortion coefficients must be finite");
-  if (lens_ == LensModel::Fisheye && dist_[4] != 0)
-    throw std::invalid_argument("Camera: the fisheye model has four distortion coefficients; the fifth must be 0");
+  const auto nonzero_from = [&](std::size_t first) {
+    return std::any_of(dist_.begin() + static_cast<std::ptrdiff_t>(first), dist_.end(), [](double c) { return c != 0; });
+  };
+  if (lens_ == LensModel::Fisheye && nonzero_from(4))
+    throw std::invalid_argument("Camera: the fisheye model has four distortion coefficients; the others must be 0");
   // A fisheye lens bends rays even with k1..k4 zero (theta, not tan theta, is proportional to
   // the distance from the principal point).
-  has_distortion_ = lens_ == LensModel::Fisheye || std::any_of(dist_.begin(), dist_.end(), [](double c) { return c != 0; });
+  has_distortion_ = lens_ == LensModel::Fisheye || nonzero_from(0);
+  if (lens_ == LensModel::Fisheye) path_ = Path::Fisheye;
+  else if (nonzero_from(5)) path_ = Path::Full;
+  else if (has_distortion_) path_ = Path::Brown;
+  tilted_ = dist_[12] != 0 || dist_[13] != 0;
+  if (tilted_) tilt_ = tilt_projection(dist_[12], dist_[13]);
 }
 
 std::expected<Camera, std::string> Camera::load(const std::string& yaml_path) {
@@ -229,7 +263,13 @@ std::expected<void, std::string> Camera::save(const std::string& yaml_path) cons
     if (!fs.isOpened()) return Error(yaml_path + ": cannot open for writing");
     fs << "image_width" << width_px_ << "image_height" << height_px_;
     const cv::Mat K = (cv::Mat_<double>(3, 3) << k_.fx_px, 0, k_.cx_px, 0, k_.fy_px, k_.cy_px, 0, 0, 1);
-    const int n = lens_ == LensModel::Fisheye ? 4 : 5;
+    // OpenCV's distCoeffs lengths: the shortest that keeps every non-zero coefficient.
+    int n = 4;
+    if (lens_ == LensModel::Pinhole) {
+      const auto last = std::find_if(dist_.rbegin(), dist_.rend(), [](double c) { return c != 0; });
+      const int used = static_cast<int>(dist_.rend() - last);
+      n = used <= 5 ? 5 : used <= 8 ? 8 : used <= 12 ? 12 : 14;
+    }
     cv::Mat d(1, n, CV_64F);
     for (int i = 0; i < n; ++i) d.at<double>(i) = dist_[static_cast<std::size_t>(i)];
     if (lens_ == LensModel::Fisheye) fs << "fisheye_model" << 1;
@@ -256,7 +296,7 @@ struct FisheyeScale {
   double s, ds_dr_over_r;
 };
 FisheyeScale fisheye_scale(const Distortion& d, double r2) {
-  const auto [k1, k2, k3, k4, unused] = d;
+  const double k1 = d[0], k2 = d[1], k3 = d[2], k4 = d[3];
   if (r2 < 1e-16) return {1.0, 2 * (k1 - 1.0 / 3.0)};
   const double r = std::sqrt(r2), theta = std::atan(r), t2 = theta * theta;
   const double theta_d = theta * (1 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
@@ -265,16 +305,64 @@ FisheyeScale fisheye_scale(const Distortion& d, double r2) {
   return {theta_d / r, (dtheta_d * dtheta_dr * r - theta_d) / (r2 * r)};
 }
 
+
+// OpenCV's full model before the tilt (cvProjectPoints2Internal's xd0, yd0), with its
+// derivative when asked for: radial (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 +
+// k6 r^6), tangential p1 p2, thin prism s1..s4.
+Eigen::Vector2d rational_distort(const Distortion& d, double x, double y, Eigen::Matrix2d* jacobian) {
+  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4], k4 = d[5], k5 = d[6], k6 = d[7];
+  const double s1 = d[8], s2 = d[9], s3 = d[10], s4 = d[11];
+  const double r2 = x * x + y * y;
+  const double num = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double inv_den = 1 / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)));
+  const double radial = num * inv_den;
+  const Eigen::Vector2d xd(x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x) + r2 * (s1 + r2 * s2),
+                           y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y + r2 * (s3 + r2 * s4));
+  if (jacobian) {
+    const double dnum = k1 + r2 * (2 * k2 + 3 * k3 * r2), dden = k4 + r2 * (2 * k5 + 3 * k6 * r2);
+    const double dradial_dr2 = (dnum - radial * dden) * inv_den;
+    const double dradial_dx = 2 * x * dradial_dr2, dradial_dy = 2 * y * dradial_dr2;
+    const double prism_x = 2 * (s1 + 2 * s2 * r2), prism_y = 2 * (s3 + 2 * s4 * r2);  // d/dr2 times 2
+    Eigen::Matrix2d& J = *jacobian;
+    J(0, 0) = radial + x * dradial_dx + 2 * p1 * y + 6 * p2 * x + prism_x * x;
+    J(0, 1) = x * dradial_dy + 2 * p1 * x + 2 * p2 * y + prism_x * y;
+    J(1, 0) = y * dradial_dx + 2 * p1 * x + 2 * p2 * y + prism_y * x;
+    J(1, 1) = radial + y * dradial_dy + 6 * p1 * y + 2 * p2 * x + prism_y * y;
+  }
+  return xd;
+}
+
+// The tilt as cv::projectPoints applies it: v = T (xd, 1), then v.xy / v.z (v.z = 0 divides by 1).
+Eigen::Vector2d apply_tilt(const Eigen::Matrix3d& T, const Eigen::Vector2d& xd, Eigen::Matrix2d* jacobian) {
+  const Eigen::Vector3d v = T * Eigen::Vector3d(xd.x(), xd.y(), 1.0);
+  const double inv = v.z() != 0 ? 1 / v.z() : 1;
+  if (jacobian) {
+    // d(v.xy / v.z) / d(xd) = (T.xy - (v.xy / v.z) T.z) / v.z on the first two columns.
+    const Eigen::Vector2d q = v.head<2>() * inv;
+    Eigen::Matrix2d D = T.topLeftCorner<2, 2>() - q * T.block<1, 2>(2, 0);
+    *jacobian = (D * inv) * *jacobian;
+  }
+  return v.head<2>() * inv;
+}
+
 }  // namespace
 
 Eigen::Vector2d Camera::normalized_to_pixel(const Eigen::Vector2d& xn) const {
   const double x = xn.x(), y = xn.y();
-  if (!has_distortion_) return {k_.fx_px * x + k_.cx_px, k_.fy_px * y + k_.cy_px};
-  if (lens_ == LensModel::Fisheye) {
-    const double s = fisheye_scale(dist_, x * x + y * y).s;
-    return {k_.fx_px * s * x + k_.cx_px, k_.fy_px * s * y + k_.cy_px};
+  switch (path_) {
+    case Path::Ideal: return {k_.fx_px * x + k_.cx_px, k_.fy_px * y + k_.cy_px};
+    case Path::Fisheye: {
+      const double s = fisheye_scale(dist_, x * x + y * y).s;
+      return {k_.fx_px * s * x + k_.cx_px, k_.fy_px * s * y + k_.cy_px};
+    }
+    case Path::Full: {
+      Eigen::Vector2d xd = rational_distort(dist_, x, y, nullptr);
+      if (tilted_) xd = apply_tilt(tilt_, xd, nullptr);
+      return {k_.fx_px * xd.x() + k_.cx_px, k_.fy_px * xd.y() + k_.cy_px};
+    }
+    case Path::Brown: break;
   }
-  const auto [k1, k2, p1, p2, k3] = dist_;
+  const double k1 = dist_[0], k2 = dist_[1], p1 = dist_[2], p2 = dist_[3], k3 = dist_[4];
   const double r2 = x * x + y * y;
   const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
   const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
@@ -284,20 +372,31 @@ Eigen::Vector2d Camera::normalized_to_pixel(const Eigen::Vector2d& xn) const {
 
 Eigen::Matrix2d Camera::normalized_to_pixel_jacobian(const Eigen::Vector2d& xn) const {
   Eigen::Matrix2d J = Eigen::Matrix2d::Identity();
-  if (has_distortion_ && lens_ == LensModel::Fisheye) {
-    const FisheyeScale f = fisheye_scale(dist_, xn.squaredNorm());
-    J = f.s * Eigen::Matrix2d::Identity() + f.ds_dr_over_r * xn * xn.transpose();
-  } else if (has_distortion_) {
-    const double x = xn.x(), y = xn.y();
-    const auto [k1, k2, p1, p2, k3] = dist_;
-    const double r2 = x * x + y * y;
-    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
-    const double dradial_dx = 2 * x * dradial_dr2, dradial_dy = 2 * y * dradial_dr2;
-    J(0, 0) = radial + x * dradial_dx + 2 * p1 * y + 6 * p2 * x;
-    J(0, 1) = x * dradial_dy + 2 * p1 * x + 2 * p2 * y;
-    J(1, 0) = y * dradial_dx + 2 * p1 * x + 2 * p2 * y;
-    J(1, 1) = radial + y * dradial_dy + 6 * p1 * y + 2 * p2 * x;
+  switch (path_) {
+    case Path::Ideal: break;
+    case Path::Fisheye: {
+      const FisheyeScale f = fisheye_scale(dist_, xn.squaredNorm());
+      J = f.s * Eigen::Matrix2d::Identity() + f.ds_dr_over_r * xn * xn.transpose();
+      break;
+    }
+    case Path::Full: {
+      const Eigen::Vector2d xd = rational_distort(dist_, xn.x(), xn.y(), &J);
+      if (tilted_) apply_tilt(tilt_, xd, &J);
+      break;
+    }
+    case Path::Brown: {
+      const double x = xn.x(), y = xn.y();
+      const double k1 = dist_[0], k2 = dist_[1], p1 = dist_[2], p2 = dist_[3], k3 = dist_[4];
+      const double r2 = x * x + y * y;
+      const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+      const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
+      const double dradial_dx = 2 * x * dradial_dr2, dradial_dy = 2 * y * dradial_dr2;
+      J(0, 0) = radial + x * dradial_dx + 2 * p1 * y + 6 * p2 * x;
+      J(0, 1) = x * dradial_dy + 2 * p1 * x + 2 * p2 * y;
+      J(1, 0) = y * dradial_dx + 2 * p1 * x + 2 * p2 * y;
+      J(1, 1) = radial + y * dradial_dy + 6 * p1 * y + 2 * p2 * x;
+      break;
+    }
   }
   J.row(0) *= k_.fx_px;
   J.row(1) *= k_.fy_px;

@@ -65,8 +65,8 @@ std::uint64_t Detector::Impl::key() const {
   h.value(camera.height_px());
   const Eigen::Matrix3d K = camera.K();
   h.bytes(K.data(), sizeof(double) * 9);
-  const auto& d = camera.distortion();
-  h.bytes(&d, sizeof d);
+  const auto& d = camera.distortion();  // all 14 of OpenCV's coefficients: a tilt changes the templates too
+  h.bytes(d.data(), sizeof(double) * d.size());
   h.value(static_cast<int>(camera.lens()));
   h.value(options.view_subdivisions);
   h.value(options.in_plane_step_deg);

@@ -1,8 +1,10 @@
 #pragma once
-// Pinhole camera with OpenCV's 5-coefficient distortion model (k1, k2, p1, p2, k3), or with
-// OpenCV's fisheye model (cv::fisheye: equidistant, k1..k4), read from and written to OpenCV
-// FileStorage YAML as OpenCV's calibrations write them.
+// Pinhole camera with OpenCV's distortion model (cv::projectPoints: k1 k2 p1 p2 k3, and the
+// rational k4 k5 k6, thin-prism s1..s4 and tilted-sensor taux tauy terms), or with OpenCV's
+// fisheye model (cv::fisheye: equidistant, k1..k4), read from OpenCV FileStorage YAML as
+// OpenCV's calibrations write them or from ROS camera_info YAML, and written as OpenCV does.
 #include <array>
+#include <cstdint>
 #include <expected>
 #include <string>
 
@@ -15,11 +17,15 @@ struct Intrinsics {
   double cx_px = 0, cy_px = 0;  // principal point in pixels
 };
 
-// OpenCV order: k1, k2, p1, p2, k3; for the fisheye model k1, k2, k3, k4 and a zero.
-using Distortion = std::array<double, 5>;
+// OpenCV's distCoeffs order: k1 k2 p1 p2 k3 k4 k5 k6 s1 s2 s3 s4 taux tauy (a calibration with
+// 4, 5, 8 or 12 of them has zeros beyond); for the fisheye model k1 k2 k3 k4 and zeros.
+using Distortion = std::array<double, 14>;
 
 // How a ray is bent onto the image.
-//   Pinhole: OpenCV's default model, radial k1 k2 k3 and tangential p1 p2 on x/z, y/z.
+//   Pinhole: OpenCV's model on x = X/Z, y = Y/Z, r^2 = x^2 + y^2:
+//            radial (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6),
+//            tangential p1 p2, thin prism s1 s2 (x) and s3 s4 (y), then the sensor tilt
+//            (taux, tauy in radians) as cv::projectPoints applies it.
 //   Fisheye: cv::fisheye's, on the angle theta of the ray from the axis:
 //            theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8).
 enum class LensModel { Pinhole, Fisheye };
@@ -32,12 +38,16 @@ class Camera {
   Camera(int width_px, int height_px, const Intrinsics& k, const Distortion& distortion = {},
          LensModel lens = LensModel::Pinhole);
 
-  // Reads image_width, image_height, camera_matrix (3x3), distortion_coefficients (1x5 or 5x1,
-  // or 1x4 / empty meaning zeros beyond). With `fisheye_model: 1` (what cv::fisheye calibration
-  // writes beside them) the four coefficients are the fisheye model's k1..k4. Errors name the
-  // file and the field. Another camera model (8, 12 or 14 coefficients, a ROS distortion_model
-  // other than plumb_bob) is an error, never silently this one.
+  // Reads image_width, image_height, camera_matrix (3x3), distortion_coefficients (a row or
+  // column of 4, 5, 8, 12 or 14 values, OpenCV's distCoeffs lengths, or empty meaning none).
+  // With `fisheye_model: 1` (what cv::fisheye calibration writes beside them) the four
+  // coefficients are the fisheye model's k1..k4. A ROS camera_info file names its model:
+  // plumb_bob (5 values, or 4), rational_polynomial (8), equidistant (4). Errors name the file
+  // and the field. Another camera model (a ROS distortion_model not listed, another count) is
+  // an error, never silently one of these.
   static std::expected<Camera, std::string> load(const std::string& yaml_path);
+  // Writes OpenCV's layout with the shortest distCoeffs length (5, 8, 12, 14; fisheye 4) that
+  // holds every non-zero coefficient, so that a 5-coefficient camera writes what it always did.
   std::expected<void, std::string> save(const std::string& yaml_path) const;
 
   int width_px() const { return width_px_; }
@@ -67,6 +77,12 @@ class Camera {
   Distortion dist_{};
   bool has_distortion_ = false;
   LensModel lens_ = LensModel::Pinhole;
+  // Which code path projects: the common 5-coefficient model keeps its short path; the
+  // rational, thin-prism and tilt terms cost only the cameras that have them.
+  enum class Path : std::uint8_t { Ideal, Brown, Full, Fisheye };
+  Path path_ = Path::Ideal;
+  bool tilted_ = false;
+  Eigen::Matrix3d tilt_ = Eigen::Matrix3d::Identity();  // OpenCV's tilt projection, from taux tauy
 };
 
 }  // namespace epichead::vision
