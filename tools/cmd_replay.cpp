@@ -7,29 +7,19 @@
 // the IMU and head-state streams (replay/onboard_replay.h), and plots (--plot). With --dbc it
 // decodes every signal the DBC files describe (replay/dbc_analysis.h): per signal its range,
 // rate and values outside the DBC's range, per message its rate against GenMsgCycleTime; the
-// values go to --csv and the signals named with --signal to a plot.
+// values go to --csv and the signals named with --signal to a plot. The analysis itself is
+// replay/replay_log.h, which the Python module (epichead.replay) runs too.
 #include <CLI/CLI.hpp>
 
-#include <expected>
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "command.h"
 #include "printable.h"
-#include "epichead/firmware_iface/candump_reader.h"
-#include "epichead/firmware_iface/dbc.h"
 #include "epichead/firmware_iface/imu_protocol.h"
-#include "replay/dbc_analysis.h"
-#include "replay/dbc_report.h"
-#include "replay/log_analysis.h"
-#include "replay/onboard_replay.h"
-#include "replay/replay_plots.h"
-#include "replay/replay_report.h"
-#include "replay/signal_csv.h"
+#include "replay/replay_log.h"
 
 namespace epichead::tools {
 namespace {
@@ -48,98 +38,29 @@ struct Options {
   std::string csv;
 };
 
-// The DBC files read and the analyzer over them; nullptr without --dbc.
-std::expected<std::unique_ptr<replay::DbcAnalyzer>, std::string> dbc_analyzer(const Options& o) {
-  if (o.dbc_files.empty()) {
-    if (!o.signals.empty() || !o.csv.empty()) return std::unexpected("--signal and --csv need --dbc FILE");
-    return nullptr;
-  }
-  if (!o.signals.empty() && o.plot_dir.empty() && o.signal_plot.empty())
-    return std::unexpected("--signal needs --plot DIR (for signals.png) or --signal-plot FILE.png");
-  std::vector<firmware_iface::Dbc> dbcs;
-  for (const auto& path : o.dbc_files) {
-    auto dbc = firmware_iface::load_dbc(path);
-    if (!dbc) return std::unexpected(dbc.error());
-    if (dbc->messages.empty()) return std::unexpected(path + ": no message (BO_) in it: is it a DBC file?");
-    // What decodes only in part is said on stderr too, as it is read (the report repeats it).
-    for (const auto& w : dbc->warnings) std::cerr << "epichead replay: warning: " << printable(w) << "\n";
-    dbcs.push_back(std::move(*dbc));
-  }
-  auto a = replay::DbcAnalyzer::create(std::move(dbcs), o.signals);
-  if (!a) return std::unexpected(a.error());
-  return std::make_unique<replay::DbcAnalyzer>(std::move(*a));
-}
-
 int run(const Options& o) {
-  replay::AnalysisOptions analysis;
-  if (!(o.bitrate > 0) || !(o.data_bitrate > 0)) return fail("replay", "--bitrate and --data-bitrate must be positive");
-  analysis.bitrate = o.bitrate;
-  analysis.data_bitrate = o.data_bitrate;
+  replay::ReplayOptions r;
+  r.bitrate = o.bitrate;
+  r.data_bitrate = o.data_bitrate;
   if (o.imu_protocol != "auto") {
     auto p = firmware_iface::parse_imu_protocol(o.imu_protocol);
     if (!p) return fail("replay", "--imu-protocol: " + p.error() + " (or 'auto')");
-    analysis.imu_protocol = *p;
+    r.imu_protocol = *p;
   }
-  // The onboard estimators re-run over the log's IMU and head-state streams.
-  replay::OnboardReplayOptions onboard_options;
-  onboard_options.predictor.imu_rate_hz = o.imu_rate_hz;
-  auto onboard = replay::OnboardReplay::create(onboard_options);
-  if (!onboard) return fail("replay", onboard.error());
-  replay::OnboardReplay& estimators = **onboard;
-  analysis.imu_observer = [&](const replay::ImuObservation& s) { estimators.add_imu(s); };
-  analysis.head_state_observer = [&](double t_s, const firmware_iface::HeadState& s) { estimators.add_head_state(t_s, s); };
-  if (std::filesystem::is_directory(o.log)) return fail("replay", o.log + ": is a directory, expected a candump log");
-  auto dbc = dbc_analyzer(o);
-  if (!dbc) return fail("replay", dbc.error());
-  auto reader = firmware_iface::CandumpReader::open(o.log);
-  if (!reader) return fail("replay", reader.error());
-  std::optional<replay::SignalCsv> csv;
-  if (!o.csv.empty()) {
-    auto opened = replay::SignalCsv::open(o.csv);
-    if (!opened) return fail("replay", opened.error());
-    csv = std::move(*opened);
-    (*dbc)->on_value([&csv](const replay::DecodedSignal& d) { csv->write(d); });
-  }
-
-  replay::LogAnalyzer analyzer(analysis);
-  firmware_iface::CandumpRecord record;
-  while (reader->next(record)) {
-    analyzer.add(record);
-    if (*dbc) (*dbc)->add(record);
-  }
-  analyzer.finish();
-  estimators.finish();
-  if (!reader->io_error().empty()) return fail("replay", o.log + ": " + reader->io_error());
-  if (csv)
-    if (auto closed = csv->close(); !closed) return fail("replay", closed.error());
-  if (analyzer.frames() == 0)
-    return fail("replay", o.log + ": no CAN frames found (" + std::to_string(reader->malformed()) +
-                              " malformed lines; expected candump log lines such as '(1436509052.249713) can0 123#DEADBEEF')");
-
-  replay::ReadSummary read{o.log, reader->lines(), reader->malformed(), {}};
-  for (const auto& e : reader->first_errors()) read.first_errors.push_back(printable(e.message(o.log)));
-  if (!o.plot_dir.empty()) {
-    const std::string title = std::filesystem::path(o.log).filename().string();
-    auto written = replay::write_plots(analyzer, o.plot_dir, title);
-    if (!written) return fail("replay", written.error());
-    if (auto att = replay::write_attitude_plot(estimators, o.plot_dir, title); !att) return fail("replay", att.error());
-  }
-  if (*dbc && !o.signals.empty()) {
-    const std::string path =
-        o.signal_plot.empty() ? (std::filesystem::path(o.plot_dir) / "signals.png").string() : o.signal_plot;
-    const std::string title = std::filesystem::path(o.log).filename().string();
-    if (auto p = replay::write_signal_plot(**dbc, path, title, analyzer.first_s()); !p) return fail("replay", p.error());
-  }
-  if (o.json) {
-    auto j = replay::report_json(read, analyzer);
-    j["fusion"] = estimators.fusion_json();
-    j["head_controller"] = estimators.controller_json();
-    if (*dbc) j["dbc"] = replay::dbc_report_json(**dbc);
-    std::cout << j.dump() << std::endl;
-  } else {
-    std::cout << replay::report_text(read, analyzer) << estimators.text();
-    if (*dbc) std::cout << replay::dbc_report_text(**dbc);
-  }
+  r.imu_rate_hz = o.imu_rate_hz;
+  r.dbc_files = o.dbc_files;
+  r.signals = o.signals;
+  r.csv = o.csv;
+  r.plot_dir = o.plot_dir;
+  r.signal_plot = o.signal_plot;
+  // What decodes only in part is said on stderr too, as it is read (the report repeats it).
+  r.on_warning = [](const std::string& w) { std::cerr << "epichead replay: warning: " << printable(w) << "\n"; };
+  auto report = replay::replay_log(o.log, r);
+  if (!report) return fail("replay", report.error());
+  if (o.json)
+    std::cout << report->json.dump() << std::endl;
+  else
+    std::cout << report->text;
   return 0;
 }
 

@@ -27,6 +27,7 @@
 #include "command.h"
 #include "printable.h"
 #include "progress.h"
+#include "selected_lines.h"
 #include "track_acquisition.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
@@ -60,29 +61,15 @@ struct TrackArgs {
 
 // Windows (grey), selected lines (green: kept by the pose, red: rejected), other candidates
 // (yellow), junctions (cyan), and the model at the estimated pose (thin, by ObjectSide colour).
-// The candidate the tracker chose for a feature before the pose judged it: validation's pick, or
-// without validation the strongest (the tracker marks a pose outlier unselected afterwards, so
-// f.selected alone would hide the wrong choices).
-int chosen_candidate(const ModelTracker& tracker, const LineFeature& f) {
-  if (tracker.options().mode == TrackMode::EpicValidation) return tracker.validation().selected[static_cast<std::size_t>(f.edge)];
-  return f.result.candidates.empty() ? -1 : 0;
-}
-
-// One row per visible edge: the selected candidate's end points (found = 0: none selected) and
-// whether the pose kept it as an inlier.
-void write_selected_lines(std::ofstream& out, const ModelTracker& tracker, const FrameReport& report, int frame_number) {
-  const auto& residuals = tracker.pose().residuals;
+// One row per visible edge: the chosen candidate's end points (found = 0: none chosen) and
+// whether the pose kept it as an inlier (selected_lines.h).
+void write_selected_lines(std::ofstream& out, const ModelTracker& tracker, const FrameReport& report, int frame_number,
+                          std::vector<SelectedLine>& scratch) {
+  selected_lines(tracker, report, scratch);
   char row[192];
-  for (const LineFeature& f : tracker.lines().features()) {
-    if (!f.visible) continue;
-    const int chosen = chosen_candidate(tracker, f);
-    const auto& cands = f.result.candidates;
-    const bool found = chosen >= 0 && chosen < static_cast<int>(cands.size());
-    const bool inlier = found && report.status != TrackStatus::Lost && static_cast<std::size_t>(f.edge) < residuals.size() &&
-                        residuals[static_cast<std::size_t>(f.edge)].inlier;
-    const LineCandidate c = found ? cands[static_cast<std::size_t>(chosen)] : LineCandidate{};
-    std::snprintf(row, sizeof row, "%d,%d,%d,%zu,%.2f,%.2f,%.2f,%.2f,%d\n", frame_number, f.edge, found ? 1 : 0, cands.size(),
-                  c.a_px.x(), c.a_px.y(), c.b_px.x(), c.b_px.y(), inlier ? 1 : 0);
+  for (const SelectedLine& l : scratch) {
+    std::snprintf(row, sizeof row, "%d,%d,%d,%d,%.2f,%.2f,%.2f,%.2f,%d\n", frame_number, l.edge, l.found ? 1 : 0, l.candidates,
+                  l.a_px.x(), l.a_px.y(), l.b_px.x(), l.b_px.y(), l.inlier ? 1 : 0);
     out << row;
   }
 }
@@ -351,6 +338,7 @@ int run_track(const TrackArgs& args) {
 
   std::vector<StampedPose> poses, vision_poses;
   std::vector<vision::StampedCovariance> vision_covariances;
+  std::vector<SelectedLine> selected;
   std::vector<double> track_ms;
   nlohmann::json per_frame = nlohmann::json::array();
   TrackCounts counts;
@@ -401,7 +389,7 @@ int run_track(const TrackArgs& args) {
     if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));
 
-    write_selected_lines(lines_csv, tracker, report, entry.frame);
+    write_selected_lines(lines_csv, tracker, report, entry.frame, selected);
 
     const bool png = args.every > 0 && (i % static_cast<std::size_t>(args.every) == 0 || i + 1 == n);
     if (png || args.video) {

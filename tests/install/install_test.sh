@@ -3,11 +3,13 @@
 # project (find_package(epichead), epichead::<module> targets) and a plain compile with
 # pkg-config, each tracking the first frames of a sequence; then the installed program runs a
 # built-in scenario away from the source tree.
-# Usage: tests/install/install_test.sh BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS]
+# With the Python module built, it imports it from the prefix and tracks a frame.
+# Usage: tests/install/install_test.sh BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
 #   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
+#   PYTHON_PRELOAD: LD_PRELOAD for python3 importing a sanitized module (the ASan runtime)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-build="$1" work="$2" seq="$3" flags="${4:-}"
+build="$1" work="$2" seq="$3" flags="${4:-}" python_preload="${5:-}"
 rm -rf "$work"
 mkdir -p "$work"
 prefix="$work/prefix"
@@ -36,6 +38,22 @@ g++ -std=c++23 $flags "$here/consumer/consumer.cpp" -o "$work/pc-consumer" $(pkg
   > "$work/pc-build.log" 2>&1 || { cat "$work/pc-build.log" >&2; exit 1; }
 "$work/pc-consumer" "$seq" 5
 version=$(pkg-config --modversion epichead)
+
+if grep -q '^EPICHEAD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then
+  step "the Python module: import epichead from the prefix"
+  python_dir=$(grep '^EPICHEAD_PYTHON_INSTALL_DIR:' "$build/CMakeCache.txt" | cut -d= -f2- || true)
+  python=$(grep '^Python_EXECUTABLE:' "$build/CMakeCache.txt" | cut -d= -f2- || true)
+  compgen -G "$prefix/$python_dir/epichead*.so" > /dev/null ||
+    { echo "install_test: no epichead*.so in $prefix/$python_dir" >&2; exit 1; }
+  (cd "$work" && PYTHONPATH="$prefix/$python_dir" LD_PRELOAD="$python_preload" ASAN_OPTIONS=detect_leaks=0 "${python:-/usr/bin/python3}" -c "
+import sys, epichead
+assert epichead.__file__.startswith('$prefix'), epichead.__file__
+seq = epichead.Sequence(sys.argv[1])
+r = epichead.Tracker(seq.camera, seq.model).track(seq.read_frame(0), seq.init.pose)
+print('install_test: python: epichead', epichead.__version__, 'frame 0', r.status)
+assert r.status == 'tracked'
+" "$seq")
+fi
 
 step "the installed program, away from the source tree"
 cd "$work"
