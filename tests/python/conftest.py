@@ -13,12 +13,17 @@ import epichead
 SHARED = pathlib.Path(os.environ.get("EPICHEAD_SHARED_DATA", pathlib.Path(__file__).parents[3] / "shared" / "data"))
 
 
-@pytest.fixture(scope="session")
-def teabox_dir():
-    path = SHARED / "teabox"
+def shared_dir(name):
+    """A folder of ../shared/data, or the test is skipped where the checkout has none beside it."""
+    path = SHARED / name
     if not path.is_dir():
         pytest.skip(f"no real data at {path}")
     return path
+
+
+@pytest.fixture(scope="session")
+def teabox_dir():
+    return shared_dir("teabox")
 
 
 @pytest.fixture(scope="session")
@@ -28,10 +33,7 @@ def teabox(teabox_dir):
 
 @pytest.fixture(scope="session")
 def can_dir():
-    path = SHARED / "can"
-    if not path.is_dir():
-        pytest.skip(f"no real data at {path}")
-    return path
+    return shared_dir("can")
 
 
 @pytest.fixture(scope="session")
