@@ -221,8 +221,9 @@ TEST_CASE("without a free turn the facet edges pin the turn and the same problem
   CHECK(std::abs(turn_rad(s.truth, result.cam_T_obj, s.axis)) < 0.01 * kDeg);
   CHECK(rotation_error_without_turn_rad(s.truth, result.cam_T_obj, s.axis) < 0.01 * kDeg);
   CHECK((result.cam_T_obj.translation() - s.truth.translation()).norm() < 1e-5);
-  // The covariance gives the turn what the two limb edges know of it (weakly, about 10 degrees
-  // here), not a free turn's default of 1 rad.
+  // The covariance gives the turn what the two limb edges know of it (weakly: about 19 degrees
+  // here, with the half pixel each line's edgels share, PoseOptions::line_shared_sigma_px), not
+  // a free turn's default of 1 rad.
   const Eigen::Vector3d d = result.cam_T_obj.linear() * s.axis.direction_obj;
-  CHECK(d.dot(result.covariance.bottomRightCorner<3, 3>() * d) < 0.1);
+  CHECK(d.dot(result.covariance.bottomRightCorner<3, 3>() * d) < 0.3);
 }
