@@ -18,7 +18,6 @@
 
 #include "command.h"
 #include "printable.h"
-#include "epichead/firmware_iface/imu_protocol.h"
 #include "replay/replay_log.h"
 
 namespace epichead::tools {
@@ -27,32 +26,15 @@ namespace {
 struct Options {
   std::string log;
   bool json = false;
-  std::string plot_dir;
-  double bitrate = 1'000'000;  // the protocol's bit rate (docs/protocol.md)
-  double data_bitrate = 2'000'000;
   std::string imu_protocol = "auto";
-  double imu_rate_hz = 1000;
-  std::vector<std::string> dbc_files;
-  std::vector<std::string> signals;  // MESSAGE.SIGNAL to plot
-  std::string signal_plot;           // PNG for them (else signals.png in plot_dir)
-  std::string csv;
+  replay::ReplayOptions replay;  // every other option goes straight in
 };
 
 int run(const Options& o) {
-  replay::ReplayOptions r;
-  r.bitrate = o.bitrate;
-  r.data_bitrate = o.data_bitrate;
-  if (o.imu_protocol != "auto") {
-    auto p = firmware_iface::parse_imu_protocol(o.imu_protocol);
-    if (!p) return fail("replay", "--imu-protocol: " + p.error() + " (or 'auto')");
-    r.imu_protocol = *p;
-  }
-  r.imu_rate_hz = o.imu_rate_hz;
-  r.dbc_files = o.dbc_files;
-  r.signals = o.signals;
-  r.csv = o.csv;
-  r.plot_dir = o.plot_dir;
-  r.signal_plot = o.signal_plot;
+  replay::ReplayOptions r = o.replay;
+  auto protocol = replay::parse_imu_protocol_or_auto(o.imu_protocol);
+  if (!protocol) return fail("replay", "--imu-protocol: " + protocol.error());
+  r.imu_protocol = *protocol;
   // What decodes only in part is said on stderr too, as it is read (the report repeats it).
   r.on_warning = [](const std::string& w) { std::cerr << "epichead replay: warning: " << printable(w) << "\n"; };
   auto report = replay::replay_log(o.log, r);
@@ -70,20 +52,20 @@ const CommandRegistration registration{
       auto o = std::make_shared<Options>();
       app.add_option("LOG", o->log, "candump log (candump -l format, or candump's default output)")->required();
       app.add_flag("--json", o->json, "Print one JSON object instead of the text report");
-      app.add_option("--plot", o->plot_dir, "Write rates.png, imu.png, head.png and attitude.png (and signals.png for --signal) into this directory");
-      app.add_option("--bitrate", o->bitrate, "Nominal bus bit rate for the bus load, bit/s (default 1000000, the bit rate docs/protocol.md "
+      app.add_option("--plot", o->replay.plot_dir, "Write rates.png, imu.png, head.png and attitude.png (and signals.png for --signal) into this directory");
+      app.add_option("--bitrate", o->replay.bitrate, "Nominal bus bit rate for the bus load, bit/s (default 1000000, the bit rate docs/protocol.md "
                      "states for the robot's bus)");
-      app.add_option("--data-bitrate", o->data_bitrate, "CAN FD data-phase bit rate, bit/s (default 2000000)");
+      app.add_option("--data-bitrate", o->replay.data_bitrate, "CAN FD data-phase bit rate, bit/s (default 2000000)");
       app.add_option("--imu-protocol", o->imu_protocol,
                      "IMU stream to plot and feed to fusion: epichead, dronecan or auto (both; default)");
-      app.add_option("--imu-rate", o->imu_rate_hz, "Nominal IMU sample rate for the fusion predictor, Hz (default 1000)")
+      app.add_option("--imu-rate", o->replay.imu_rate_hz, "Nominal IMU sample rate for the fusion predictor, Hz (default 1000)")
           ->check(CLI::Range(1.0, 100000.0));
-      app.add_option("--dbc", o->dbc_files,
+      app.add_option("--dbc", o->replay.dbc_files,
                      "DBC file(s) describing other frames on the bus: every signal is decoded and reported "
                      "(range, rate, values outside the DBC's range, period against GenMsgCycleTime)");
-      app.add_option("--signal", o->signals, "MESSAGE.SIGNAL of a DBC to plot against time (repeatable)");
-      app.add_option("--signal-plot", o->signal_plot, "PNG for the --signal plot (default: signals.png in --plot DIR)");
-      app.add_option("--csv", o->csv,
+      app.add_option("--signal", o->replay.signals, "MESSAGE.SIGNAL of a DBC to plot against time (repeatable)");
+      app.add_option("--signal-plot", o->replay.signal_plot, "PNG for the --signal plot (default: signals.png in --plot DIR)");
+      app.add_option("--csv", o->replay.csv,
                      "Write every decoded DBC signal value: one row per value, t_s,id,message,signal,raw,value,unit,text");
       return [o]() -> int { return run(*o); };
     }};

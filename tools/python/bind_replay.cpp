@@ -7,7 +7,6 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
-#include "epichead/firmware_iface/imu_protocol.h"
 #include "replay/replay_log.h"
 
 namespace epichead::python {
@@ -21,11 +20,9 @@ void bind_replay(py::module_& m) {
         tools::replay::ReplayOptions o;
         o.bitrate = bitrate;
         o.data_bitrate = data_bitrate;
-        if (imu_protocol != "auto") {
-          auto p = firmware_iface::parse_imu_protocol(imu_protocol);
-          if (!p) throw Error("imu_protocol: " + p.error() + " (or 'auto')");
-          o.imu_protocol = *p;
-        }
+        auto protocol = tools::replay::parse_imu_protocol_or_auto(imu_protocol);
+        if (!protocol) throw Error("imu_protocol: " + protocol.error());
+        o.imu_protocol = *protocol;
         o.imu_rate_hz = imu_rate_hz;
         o.dbc_files = dbc;
         o.signals = signals;

@@ -43,6 +43,13 @@ std::expected<std::unique_ptr<DbcAnalyzer>, std::string> dbc_analyzer(const Repl
 
 }  // namespace
 
+std::expected<std::optional<firmware_iface::ImuProtocol>, std::string> parse_imu_protocol_or_auto(const std::string& name) {
+  if (name == "auto") return std::nullopt;
+  auto p = firmware_iface::parse_imu_protocol(name);
+  if (!p) return std::unexpected(p.error() + " (or 'auto')");
+  return *p;
+}
+
 std::expected<ReplayReport, std::string> replay_log(const std::string& log_path, const ReplayOptions& o) {
   if (!(o.bitrate > 0) || !(o.data_bitrate > 0))
     return std::unexpected("--bitrate and --data-bitrate must be positive");

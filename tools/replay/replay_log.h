@@ -36,6 +36,10 @@ struct ReplayReport {
   std::string text;     // what `replay` prints
 };
 
+// The IMU stream named on a command line or in Python: "auto" (both, nullopt) or a protocol as
+// firmware_iface::parse_imu_protocol reads it.
+std::expected<std::optional<firmware_iface::ImuProtocol>, std::string> parse_imu_protocol_or_auto(const std::string& name);
+
 // Errors name the file and what is wrong (a log with no CAN frame, a DBC that does not parse,
 // options that do not fit together).
 std::expected<ReplayReport, std::string> replay_log(const std::string& log_path, const ReplayOptions& options);
