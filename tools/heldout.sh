@@ -7,15 +7,18 @@
 # docs/results.md); each simulation's stderr goes to DIR/seq/<scenario>-<seed>.sim.log. On a
 # terminal, a progress line on stderr (sequences done, time taken, time left: tools/progress.sh).
 # Usage: tools/heldout.sh [--dev "1 2 3"] [--held "101 ... 110"] [--scenarios "a b"] [--frames N]
-#                         [--jobs J] [--out DIR]
+#                         [--modes "m1 m2"] [--jobs J] [--out DIR]
 #   --dev, --held   seed lists (defaults: 1 2 3 and 101..112)
 #   --scenarios     default: every built-in scenario
 #   --frames N      simulate only the first N frames (default: the scenario's own)
+#   --modes         tracker modes (default: gradient epic epic+validation); the table then
+#                   has rows for these only
 #   --jobs J        sequences simulated and tracked at once (default: nproc)
+# Environment: EPICHEAD_BIN, the program to run (default: build/bin/epichead of this checkout).
 # Needs jq.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bin="$here/build/bin/epichead"
+bin="${EPICHEAD_BIN:-$here/build/bin/epichead}"  # another build: EPICHEAD_BIN=path
 # shellcheck source=progress.sh
 . "$here/tools/progress.sh"
 
@@ -41,7 +44,7 @@ one() {
   : > "$rows.part"
   local imus=(off)
   [[ -f "$seq/imu.csv" ]] && imus=(off on)
-  for mode in gradient epic epic+validation; do
+  for mode in ${HELDOUT_MODES:-gradient epic epic+validation}; do
     for imu in "${imus[@]}"; do
       local dir="$out/track/$scenario-$seed/$mode-imu-$imu"
       mkdir -p "$dir"
@@ -99,14 +102,16 @@ while (($#)); do
     --held) held="$2"; shift 2 ;;
     --scenarios) scenarios="$2"; shift 2 ;;
     --frames) frames="$2"; shift 2 ;;
+    --modes) export HELDOUT_MODES="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "heldout: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
 command -v jq >/dev/null || { echo "heldout: jq is missing (apt-get install jq)" >&2; exit 1; }
 [[ -x "$bin" ]] || "$here/dev" build > /dev/null
+[[ -x "$bin" ]] || { echo "heldout: $bin is not a program" >&2; exit 1; }
 if [[ -z "$scenarios" ]]; then
   scenarios=$(ls "$here/sim/scenarios/"*.scn | xargs -n1 basename | sed 's/\.scn$//' | tr '\n' ' ')
 fi
