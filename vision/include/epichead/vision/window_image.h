@@ -3,6 +3,7 @@
 // per pixel four floats (intensity, chromaticity r, chromaticity g, texture), interleaved so
 // that one bilinear tap reads all cue channels at once. The per-window hot path never touches
 // cv::Mat; this is the image boundary.
+#include <cstdint>
 #include <expected>
 #include <string>
 #include <vector>
@@ -31,10 +32,17 @@ class WindowImage {
   const float* pixels() const { return pixels_.data(); }
 
  private:
+  void convert_pixels(const cv::Mat& frame);
+  void texture_gradient();
+  void interleave_with_texture();
+
   int width_px_ = 0, height_px_ = 0;
   bool colour_ = false;
   std::vector<float> pixels_;
-  std::vector<float> gradient_;  // scratch: |dI/dx| + |dI/dy| before the 3x3 mean
+  // Scratch, one plane per channel before they are interleaved (contiguous loops vectorise).
+  std::vector<std::uint8_t> bgr_;  // the frame's B, G and R planes
+  std::vector<float> intensity_, chroma_r_, chroma_g_;
+  std::vector<float> gradient_;   // scratch: |dI/dx| + |dI/dy| before the 3x3 mean
 };
 
 }  // namespace epichead::vision
