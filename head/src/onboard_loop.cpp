@@ -442,6 +442,7 @@ std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, cons
   out.frame_age_at_take_ms_median = s.frame_age_ms.percentile(0.5);
   out.result_to_command_ms_max = s.overhead_ms.max();
   out.controller = s.controller.counters();
+  out.backlash_band = s.controller.backlash_band();
   out.imu_assembly = s.assembler.counters();
   out.imu_clock = s.imu_clock.counters();
   out.predictor = s.predictor.status(s.ports.clock->now_s()).counters;
