@@ -16,30 +16,24 @@ void BacklashEstimator::camera_rate(double joint_rate_radps, double dt_s) {
 
 void BacklashEstimator::restart_leg() {
   have_reading_ = false;
-  direction_ = reference_direction_ = 0;
-  leg_engaged_ = pending_ = false;
+  direction_ = 0;
+  leg_engaged_ = leg_from_edge_ = pending_ = false;
 }
 
-void BacklashEstimator::motor_angle(double t_s, double motor_rad) {
-  if (!options_.enabled || !std::isfinite(t_s) || !std::isfinite(motor_rad)) return;
-  const double dt = t_s - previous_.t_s;
-  if (have_reading_ && !(dt > 0)) return;
-  if (have_reading_ && dt > options_.max_reading_gap_s) restart_leg();
+void BacklashEstimator::motor_angle(double t_s, double motor_rad, double body_joint_rate_radps) {
+  if (!options_.enabled || !std::isfinite(t_s) || !std::isfinite(motor_rad) || !std::isfinite(body_joint_rate_radps))
+    return;
+  if (have_reading_ && !(t_s > previous_t_s_)) return;
+  if (have_reading_ && t_s - previous_t_s_ > options_.max_reading_gap_s) restart_leg();
+  previous_t_s_ = t_s;
+  const Reading now{t_s, motor_rad, camera_rad_, body_joint_rate_radps};
   if (!have_reading_) {
     have_reading_ = true;
-    body_radps_ = 0;
-    previous_ = extreme_ = {t_s, motor_rad, camera_rad_, 0};
+    extreme_ = now;
     return;
   }
-  // The body's rate about the joint over the interval: the camera's less the output's (the
-  // motor's while they move together, none while the output rests in the band).
-  const double output_radps = leg_engaged_ ? (motor_rad - previous_.motor_rad) / dt : 0;
-  const double raw_body_radps = (camera_rad_ - previous_.camera_rad) / dt - output_radps;
-  body_before_radps_ = body_radps_;
-  body_radps_ += dt / (options_.body_filter_s + dt) * (raw_body_radps - body_radps_);
-  Reading now{t_s, motor_rad, camera_rad_, body_radps_};
-  previous_ = now;
   if (direction_ == 0) {
+    // The first leg: whether the output sat on an edge at its start is unknown.
     if (std::abs(motor_rad - extreme_.motor_rad) < options_.reversal_rad) return;
     direction_ = motor_rad > extreme_.motor_rad ? 1 : -1;
     leg_ = extreme_;
@@ -47,13 +41,10 @@ void BacklashEstimator::motor_angle(double t_s, double motor_rad) {
   } else if (direction_ * (motor_rad - extreme_.motor_rad) > 0) {
     extreme_ = now;
   } else if (direction_ * (extreme_.motor_rad - motor_rad) >= options_.reversal_rad) {
-    // Turned back at the extreme. A sample still waiting for its confirmation stands: its
-    // crossing ended and the output moved with the motor until it turned.
+    // Turned back at the extreme: the output sat on the edge there if it moved with the motor.
+    // A sample still waiting for its confirmation stands: its crossing ended, the motor turned.
     if (pending_) settle_pending(true);
-    if (leg_engaged_) {  // the output sits on the edge the motor left here
-      reference_ = extreme_;
-      reference_direction_ = direction_;
-    }
+    leg_from_edge_ = leg_engaged_;
     leg_engaged_ = false;
     direction_ = -direction_;
     leg_ = extreme_;
@@ -62,13 +53,11 @@ void BacklashEstimator::motor_angle(double t_s, double motor_rad) {
   follow_crossing(now);
 }
 
-void BacklashEstimator::follow_crossing(Reading& now) {
-  // The output's travel this leg's way since it last moved (from the reference, or without one
-  // from the leg's start), the body's turning taken at its rate then.
-  const Reading& from = reference_direction_ != 0 ? reference_ : leg_;
-  const double output_rad = direction_ * ((now.camera_rad - from.camera_rad) - from.body_radps * (now.t_s - from.t_s));
-  // The motor's travel from the reference less the output's: the band once the output moves.
-  const double band_rad = direction_ * (now.motor_rad - from.motor_rad) - output_rad;
+void BacklashEstimator::follow_crossing(const Reading& now) {
+  // The output's travel the new way, the body's turning taken at its rate at the leg's start,
+  // and the motor's travel less it: the band once the output has reached the far edge.
+  const double output_rad = direction_ * ((now.camera_rad - leg_.camera_rad) - leg_.body_radps * (now.t_s - leg_.t_s));
+  const double band_rad = direction_ * (now.motor_rad - leg_.motor_rad) - output_rad;
   if (pending_) {
     if (band_rad - pending_rad_ > options_.confirm_tolerance_rad) settle_pending(false);
     else if (now.t_s - pending_t_s_ >= options_.confirm_s) settle_pending(true);
@@ -76,14 +65,8 @@ void BacklashEstimator::follow_crossing(Reading& now) {
   }
   if (leg_engaged_ || output_rad < options_.engaged_rad) return;
   leg_engaged_ = true;
-  // The output started to move within the last interval, which took its turning for the body's:
-  // the body's rate stays as it was before it.
-  body_radps_ = now.body_radps = body_before_radps_;
-  previous_.body_radps = body_radps_;
-  if (extreme_.t_s == now.t_s) extreme_.body_radps = body_radps_;
-  // Moving on the way it last went, or no reference: no band crossed.
-  if (reference_direction_ != -direction_) return;
-  if (now.t_s - from.t_s > options_.max_crossing_s || std::abs(from.body_radps) > options_.quiet_body_radps ||
+  if (!leg_from_edge_) return;
+  if (now.t_s - leg_.t_s > options_.max_crossing_s || std::abs(leg_.body_radps) > options_.quiet_body_radps ||
       std::abs(now.body_radps) > options_.quiet_body_radps || !(band_rad >= 0) || band_rad > options_.max_rad) {
     ++rejected_;
     return;

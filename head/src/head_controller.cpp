@@ -115,7 +115,6 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
                                  std::pair{be.reversal_rad, "backlash_estimate.reversal_rad"},
                                  std::pair{be.engaged_rad, "backlash_estimate.engaged_rad"},
                                  std::pair{be.max_crossing_s, "backlash_estimate.max_crossing_s"},
-                                 std::pair{be.body_filter_s, "backlash_estimate.body_filter_s"},
                                  std::pair{be.quiet_body_radps, "backlash_estimate.quiet_body_radps"},
                                  std::pair{be.confirm_tolerance_rad, "backlash_estimate.confirm_tolerance_rad"},
                                  std::pair{be.max_reading_gap_s, "backlash_estimate.max_reading_gap_s"},
@@ -298,9 +297,10 @@ void HeadController::measure_backlash(bool new_gyro, bool new_head, double gyro_
       tilt_play_.camera_rate(camera_joint.y(), gyro_dt_s);
     }
   }
-  if (new_head) {
-    pan_play_.motor_angle(head_.t_s, head_.angles.pan_rad);
-    tilt_play_.motor_angle(head_.t_s, head_.angles.tilt_rad);
+  if (new_head && have_body_rate_) {
+    const Eigen::Vector2d body_joint = A_inv * body_rate_cam_.head<2>();
+    pan_play_.motor_angle(head_.t_s, head_.angles.pan_rad, body_joint.x());
+    tilt_play_.motor_angle(head_.t_s, head_.angles.tilt_rad, body_joint.y());
     pan_backlash_.set_band(pan_play_.band_rad(options_.backlash.pan_rad), pan_cmd_.angle_rad);
     tilt_backlash_.set_band(tilt_play_.band_rad(options_.backlash.tilt_rad), tilt_cmd_.angle_rad);
     counters_.backlash_samples = pan_play_.samples() + tilt_play_.samples();

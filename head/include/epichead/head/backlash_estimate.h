@@ -1,23 +1,21 @@
 #pragma once
 // Online estimate of one joint's gear backlash, for a head whose play was not calibrated (or
 // has grown since). The encoder is on the motor and the gyro on the camera, which the output
-// shaft carries: the output rests inside the dead band until the motor pushes it at either
-// edge. After the output last moved with the motor (pushed the one way), it sits on that edge,
-// half a band from where the motor then turned back (the reference); however the motor wanders
-// inside the band meanwhile, the output moves again only when the motor reaches the far edge,
-// a band away. So when the output next moves the *other* way, the motor's travel from the
-// reference less the output's is the band. The output's travel is the camera's rotation about
-// the joint (the gyro's x/y rate in joint space, integrated) less the body's; the body's rate
-// is the camera's less the output's own (the motor's while they move together, zero while the
-// output rests), low-passed over body_filter_s, and taken as constant from the reference on.
+// shaft carries: after the motor reverses, the output rests while the motor crosses the dead
+// band, then moves with it again. Measured per reversal, from the motor's extreme: the motor's
+// travel less the output's at the first encoder reading after the output has moved the new way
+// by engaged_rad (it reached the far edge) is the band. The output's travel is the camera's
+// rotation about the joint (the gyro's x/y rate in joint space, integrated) less the body's,
+// taken as turning at the rate it had at the extreme over the crossing's tens of milliseconds.
 //
-// A sample counts only when the body was quiet at the reference and when the output moved
-// (|rate about the joint| at most quiet_body_radps: inside a walking step's burst the held rate
-// says nothing about the next milliseconds), the output moved at most max_crossing_s after the
-// reference, the sample is within [0, max_rad], and the band measured at the next readings does
-// not grow by more than confirm_tolerance_rad within confirm_s (else the output's "arrival" was
-// the body's turning); the others are counted as rejected. The estimate is the median of the
-// last `window` samples. Fixed storage, no allocation.
+// A reversal gives a sample only when the output sat on the band's edge at the extreme (it moved
+// with the motor on the leg before), the body was quiet (|rate about the joint| at most
+// quiet_body_radps: inside a walking step's burst the held rate says nothing about the next
+// milliseconds), the crossing took at most max_crossing_s, the sample is within [0, max_rad],
+// and the band measured at the next readings does not grow by more than confirm_tolerance_rad
+// within confirm_s (else the output's "arrival" was the body's turning); the others are counted
+// as rejected. The estimate is the median of the last `window` samples. Fixed storage, no
+// allocation.
 #include <array>
 #include <cstdint>
 
@@ -34,8 +32,7 @@ struct BacklashEstimateOptions {
   // The output has moved this far the new way: it reached the far edge. Above the gyro's noise
   // and bias integrated over a crossing (tens of microradians).
   double engaged_rad = 1.5e-4;
-  double max_crossing_s = 0.15;         // a longer crossing is not measured: the body's rate is held over it
-  double body_filter_s = 0.02;          // low-pass of the body's rate (gyro noise, held over the crossing)
+  double max_crossing_s = 0.1;          // a longer crossing is not measured: the body's rate is held over it
   double quiet_body_radps = 0.02;       // the body turns slower than this about the joint: a sample may be taken
   double confirm_s = 0.015;             // the band must hold this long after the crossing (or until the next reversal)
   double confirm_tolerance_rad = 1.5e-4;  // by this much: two readings' rounding and a little
@@ -60,8 +57,9 @@ class BacklashEstimator {
   // A gyro sample: the camera's rotation rate about this joint (the joint-space share of the
   // gyro's x/y rate) over the dt_s since the previous one.
   void camera_rate(double joint_rate_radps, double dt_s);
-  // An encoder reading of the motor angle at t_s (after the gyro samples up to t_s).
-  void motor_angle(double t_s, double motor_rad);
+  // An encoder reading of the motor angle at t_s (after the gyro samples up to t_s), with the
+  // body's rate about the joint now (the gyro's less the joints' own).
+  void motor_angle(double t_s, double motor_rad, double body_joint_rate_radps);
   // Forget the leg in progress (a gap in the gyro, a restart of the commands); samples stay.
   void restart_leg();
 
@@ -76,32 +74,26 @@ class BacklashEstimator {
   std::uint64_t rejected() const { return rejected_; }
 
  private:
-  // A motor reading with the camera's joint-space angle and the body's (low-passed) rate about
-  // the joint then.
+  // A motor reading with the camera's joint-space angle and the body's rate about the joint then.
   struct Reading {
     double t_s = 0, motor_rad = 0, camera_rad = 0, body_radps = 0;
   };
-  // Whether the output moves with the motor on the leg in progress yet, and the sample when it
-  // starts to move the other way from the reference (or the confirmation of that sample).
-  void follow_crossing(Reading& now);
+  // Where the crossing of the leg in progress stands at `now`: ends it (engaged) or confirms
+  // the sample it gave.
+  void follow_crossing(const Reading& now);
   void settle_pending(bool confirmed);
   void take_sample(double band_rad);
 
   BacklashEstimateOptions options_;
   double camera_rad_ = 0;  // the camera's joint-space angle: the integral of camera_rate()
   bool have_reading_ = false;
-  Reading previous_;
-  double body_radps_ = 0;         // low-passed
-  double body_before_radps_ = 0;  // before the last reading's interval
+  double previous_t_s_ = 0;
   // The leg in progress: where it started (the extreme the motor turned at), its extreme so far,
   // the motor's direction on it (+1 / -1, 0: not yet known).
   Reading leg_, extreme_;
   int direction_ = 0;
   bool leg_engaged_ = false;      // the output has moved with the motor on this leg
-  // The reference: the extreme of the last leg on which the output moved with the motor, and
-  // that leg's direction (0: none yet).
-  Reading reference_;
-  int reference_direction_ = 0;
+  bool leg_from_edge_ = false;    // and did on the previous one: the output sat on the edge
   bool pending_ = false;          // a sample from this leg's crossing, not yet confirmed
   double pending_rad_ = 0, pending_t_s_ = 0;
   std::array<double, kMaxWindow> recent_{};
