@@ -99,6 +99,9 @@ struct RunMeasures {
   // attitude error at each frame's exposure (t_s, deg).
   double rss_warm_kib = 0, rss_end_kib = 0, rss_max_kib = 0;
   std::vector<std::pair<double, double>> attitude_error_deg;  // sized (and touched) before the run
+  // The tracker's own attitude error on the same frames (NaN when lost): tells a prediction that
+  // ran off from a tracker that settled on a wrong pose (the predictor then follows it).
+  std::vector<double> tracked_attitude_error_deg;
   std::size_t attitude_errors = 0;                            // entries filled
 };
 
@@ -210,8 +213,12 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
   if (a.soak) {
     if (auto truth = w.truth_at(f.exposure_t_s)) {
       const Eigen::Matrix3d d = f.predicted_cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
-      if (m.attitude_errors < m.attitude_error_deg.size())
+      if (m.attitude_errors < m.attitude_error_deg.size()) {
+        const Eigen::Matrix3d dt = f.report->cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
+        m.tracked_attitude_error_deg[m.attitude_errors] =
+            f.report->status == vision::TrackStatus::Lost ? std::nan("") : Eigen::AngleAxisd(dt).angle() * 180 / M_PI;
         m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
+      }
     }
   }
   const auto& covers = w.scenario().covers;
@@ -307,7 +314,10 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   int overlays = 0;
   const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
   // Sized up front (so its pages are resident before the baseline): the measuring must not grow.
-  if (a.soak) m.attitude_error_deg.assign(static_cast<std::size_t>(until * scenario.fps) + 16, {0.0, 0.0});
+  if (a.soak) {
+    m.attitude_error_deg.assign(static_cast<std::size_t>(until * scenario.fps) + 16, {0.0, 0.0});
+    m.tracked_attitude_error_deg.assign(m.attitude_error_deg.size(), 0.0);
+  }
   const head::FrameHook hook = [&](const head::TrackedFrame& f) {
     measure_frame(f, w, a, symmetries, m);
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
@@ -355,8 +365,10 @@ int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::
   // The error at every frame, for finding when and how it grew.
   const std::string errors_path = (fs::path(a.out) / "attitude_error.csv").string();
   std::ofstream errors(errors_path);
-  errors << "t_s,predicted_attitude_error_deg\n";
-  for (const auto& [t, e] : m.attitude_error_deg) errors << t << ',' << e << '\n';
+  errors << "t_s,predicted_attitude_error_deg,tracked_attitude_error_deg\n";
+  for (std::size_t i = 0; i < m.attitude_error_deg.size(); ++i)
+    errors << m.attitude_error_deg[i].first << ',' << m.attitude_error_deg[i].second << ','
+           << m.tracked_attitude_error_deg[i] << '\n';
   std::printf("sim-run %s --soak (%s, seed %llu): %.0f s simulated, %d frames (%llu tracked, %llu lost)\n",
               scenario.name.c_str(), a.mode.c_str(), static_cast<unsigned long long>(scenario.seed), end_s, m.frames,
               static_cast<unsigned long long>(run.tracked), static_cast<unsigned long long>(run.lost));

@@ -11,6 +11,15 @@ void BacklashCompensator::reset(double motor_angle_rad) {
   last_output_rate_radps_ = 0;
 }
 
+void BacklashCompensator::set_band(double backlash_rad, double motor_angle_rad) {
+  const double half = 0.5 * std::max(0.0, backlash_rad);
+  if (half == half_rad_) return;
+  // Off until now: the output was modelled as moving with the motor.
+  if (!active()) reset(motor_angle_rad);
+  half_rad_ = half;
+  place(motor_angle_rad);
+}
+
 void BacklashCompensator::place(double motor_angle_rad) {
   output_rad_ = std::clamp(output_rad_, motor_angle_rad - half_rad_, motor_angle_rad + half_rad_);
 }

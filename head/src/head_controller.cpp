@@ -110,6 +110,22 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
     if (auto ok = non_negative(v, name); !ok) return std::unexpected(ok.error());
     if (v > 0.5) return std::unexpected(std::string("head controller options: ") + name + " above 0.5 rad");
   }
+  const BacklashEstimateOptions& be = o.backlash_estimate;
+  for (const auto& [v, name] : {std::pair{be.max_rad, "backlash_estimate.max_rad"},
+                                 std::pair{be.reversal_rad, "backlash_estimate.reversal_rad"},
+                                 std::pair{be.engaged_rad, "backlash_estimate.engaged_rad"},
+                                 std::pair{be.max_crossing_s, "backlash_estimate.max_crossing_s"},
+                                 std::pair{be.quiet_body_radps, "backlash_estimate.quiet_body_radps"},
+                                 std::pair{be.confirm_tolerance_rad, "backlash_estimate.confirm_tolerance_rad"},
+                                 std::pair{be.max_reading_gap_s, "backlash_estimate.max_reading_gap_s"},
+                                 std::pair{be.applied_fraction, "backlash_estimate.applied_fraction"}})
+    if (auto ok = positive(v, name); !ok) return std::unexpected(ok.error());
+  if (auto ok = non_negative(be.confirm_s, "backlash_estimate.confirm_s"); !ok) return std::unexpected(ok.error());
+  if (auto ok = non_negative(be.min_applied_rad, "backlash_estimate.min_applied_rad"); !ok) return std::unexpected(ok.error());
+  if (be.max_rad > 0.5) return std::unexpected("head controller options: backlash_estimate.max_rad above 0.5 rad");
+  if (be.applied_fraction > 1) return std::unexpected("head controller options: backlash_estimate.applied_fraction above 1");
+  if (be.window < 1 || be.window > BacklashEstimator::kMaxWindow || be.min_samples < 1 || be.min_samples > be.window)
+    return std::unexpected("head controller options: backlash_estimate.window must be in [1, 31] and min_samples in [1, window]");
   if (o.safe_mode != ControlMode::Hold && o.safe_mode != ControlMode::Park)
     return std::unexpected("head controller options: safe_mode must be hold or park");
   if (!finite(o.mount.pan_origin_body) || !finite(o.mount.tilt_origin_pan) || !finite(o.mount.cam_offset_tilt) ||
@@ -121,7 +137,8 @@ std::expected<HeadController, std::string> HeadController::create(const HeadCont
 HeadController::HeadController(const HeadControllerOptions& o)
     // The IMU may run faster than the loop: room for 2 kHz over the history.
     : options_(o), watchdog_(o.watchdog), attitude_(o.history_s, std::max(o.rate_hz, 2000.0)), joint_rates_(o.joint_rates),
-      pan_backlash_(o.backlash.pan_rad), tilt_backlash_(o.backlash.tilt_rad) {}
+      pan_backlash_(o.backlash.pan_rad), tilt_backlash_(o.backlash.tilt_rad), pan_play_(o.backlash_estimate),
+      tilt_play_(o.backlash_estimate) {}
 
 void HeadController::emit(ControlOutput& out, const HeadEvent& e) {
   ++counters_.events;
@@ -130,11 +147,13 @@ void HeadController::emit(ControlOutput& out, const HeadEvent& e) {
 }
 
 void HeadController::ingest(const ControlInput& in) {
-  bool new_gyro = false;
+  bool new_gyro = false, new_head = false;
+  double gyro_dt_s = 0;
   if (in.gyro && !(have_gyro_ && in.gyro->t_s == gyro_.t_s)) {
     if (!finite(in.gyro->t_s) || !finite(in.gyro->gyro_radps) || (have_gyro_ && in.gyro->t_s < gyro_.t_s)) {
       ++counters_.gyro_rejected;
     } else {
+      gyro_dt_s = have_gyro_ ? in.gyro->t_s - gyro_.t_s : 0;
       attitude_.add(in.gyro->t_s, in.gyro->gyro_radps, options_.watchdog.imu_timeout_s);
       gyro_ = *in.gyro;
       have_gyro_ = true;
@@ -149,10 +168,12 @@ void HeadController::ingest(const ControlInput& in) {
     } else {
       head_ = h;
       have_head_ = true;
+      new_head = true;
       joint_rates_.measured(h.t_s, {h.pan_rate_radps, h.tilt_rate_radps});
     }
   }
   if (new_gyro && have_head_) update_body_rate();
+  measure_backlash(new_gyro, new_head, gyro_dt_s);
   if (in.target && !(have_target_ && in.target->t_s == target_t_s_)) {
     const TargetObservation& obs = *in.target;
     Eigen::Quaterniond inertial_R_cam;
@@ -208,6 +229,8 @@ void HeadController::command_from_head() {
                clamp_rate(head_.tilt_rate_radps, options_.tilt)};
   pan_backlash_.reset(pan_cmd_.angle_rad);
   tilt_backlash_.reset(tilt_cmd_.angle_rad);
+  pan_play_.restart_leg();
+  tilt_play_.restart_leg();
 }
 
 void HeadController::enter(ControlMode mode, ModeReason reason, double t_s, ControlOutput& out) {
@@ -254,6 +277,35 @@ void HeadController::update_body_rate() {
   body_rate_cam_ = body;
   body_rate_t_s_ = gyro_.t_s;
   have_body_rate_ = true;
+}
+
+// The play of each gear, from the gyro's rate about the joints and the encoder's motor angles
+// (backlash_estimate.h); a wider band than calibrated goes to the compensation.
+void HeadController::measure_backlash(bool new_gyro, bool new_head, double gyro_dt_s) {
+  if (!options_.backlash_estimate.enabled || !have_head_ || !have_gyro_ || (!new_gyro && !new_head)) return;
+  const Eigen::Matrix2d A = joint_axes_cam(options_.mount, head_.angles).topRows<2>();
+  // Near +-90 deg tilt the pan axis lines up with the optical axis: no joint-space split there.
+  if (!(std::abs(A.determinant()) > 0.2)) return;
+  const Eigen::Matrix2d A_inv = A.inverse();
+  if (new_gyro) {
+    if (gyro_dt_s > options_.watchdog.imu_timeout_s) {  // a gap: the camera's turning meanwhile is unknown
+      pan_play_.restart_leg();
+      tilt_play_.restart_leg();
+    } else {
+      const Eigen::Vector2d camera_joint = A_inv * gyro_.gyro_radps.head<2>();
+      pan_play_.camera_rate(camera_joint.x(), gyro_dt_s);
+      tilt_play_.camera_rate(camera_joint.y(), gyro_dt_s);
+    }
+  }
+  if (new_head && have_body_rate_) {
+    const Eigen::Vector2d body_joint = A_inv * body_rate_cam_.head<2>();
+    pan_play_.motor_angle(head_.t_s, head_.angles.pan_rad, body_joint.x());
+    tilt_play_.motor_angle(head_.t_s, head_.angles.tilt_rad, body_joint.y());
+    pan_backlash_.set_band(pan_play_.band_rad(options_.backlash.pan_rad), pan_cmd_.angle_rad);
+    tilt_backlash_.set_band(tilt_play_.band_rad(options_.backlash.tilt_rad), tilt_cmd_.angle_rad);
+    counters_.backlash_samples = pan_play_.samples() + tilt_play_.samples();
+    counters_.backlash_samples_rejected = pan_play_.rejected() + tilt_play_.rejected();
+  }
 }
 
 Eigen::Vector2d HeadController::camera_rate_law(const Eigen::Vector2d& camera_rate_xy_radps) const {

@@ -271,6 +271,13 @@ struct OnboardLoop::Impl {
                            {"lost", summary.lost},
                            {"imu_samples", summary.imu_samples},
                            {"predictor_coasting", st.coasting},
+                           {"predictor", {{"vision_applied", st.counters.vision_applied},
+                                          {"vision_gated", st.counters.vision_gated},
+                                          {"vision_rejected", st.counters.vision_too_old + st.counters.vision_out_of_order +
+                                                                  st.counters.vision_bad_input + st.counters.vision_no_imu},
+                                          {"reinitialisations", st.counters.reinitialisations},
+                                          {"imu_restarts", st.counters.imu_restarts},
+                                          {"last_nis", st.last_nis}}},
                            {"commands_sent", summary.commands_sent},
                            {"bus_state", hw::to_string(bus_state)},
                            {"target_error_deg", std::isfinite(out.target_error_rad) ? out.target_error_rad * 180 / M_PI : -1.0},
@@ -442,6 +449,7 @@ std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, cons
   out.frame_age_at_take_ms_median = s.frame_age_ms.percentile(0.5);
   out.result_to_command_ms_max = s.overhead_ms.max();
   out.controller = s.controller.counters();
+  out.backlash_band = s.controller.backlash_band();
   out.imu_assembly = s.assembler.counters();
   out.imu_clock = s.imu_clock.counters();
   out.predictor = s.predictor.status(s.ports.clock->now_s()).counters;

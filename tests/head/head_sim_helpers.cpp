@@ -127,7 +127,8 @@ Eigen::Vector3d ClosedLoop::target_cam() const {
   // The head sits at the body origin's mount; the body does not translate in these tests.
   const Eigen::Isometry3d world_T_body(plant_.world_R_body());
   const Eigen::Isometry3d world_T_cam = head::world_T_cam(world_T_body, controller_.options().mount, plant_.angles());
-  return world_T_cam.inverse() * (options_.target_world + options_.target_velocity_mps * t_s_);
+  const double sway = std::sin(2 * M_PI * t_s_ / options_.target_sway_period_s);
+  return world_T_cam.inverse() * (options_.target_world + options_.target_velocity_mps * t_s_ + options_.target_sway_m * sway);
 }
 
 double ClosedLoop::target_angle_rad() const {

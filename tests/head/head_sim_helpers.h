@@ -84,6 +84,8 @@ struct LoopOptions {
   double target_noise_rad = 0;     // per-frame direction noise of the tracker
   Eigen::Vector3d target_world = Eigen::Vector3d(4, 0, 0.4);  // at t = 0, world = body frame at the start
   Eigen::Vector3d target_velocity_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d target_sway_m = Eigen::Vector3d::Zero();  // and to and fro by this much (sine)
+  double target_sway_period_s = 2.0;
   bool stamp_at_arrival = false;   // give the tracker's result the arrival time instead of the exposure time (wrong)
 };
 

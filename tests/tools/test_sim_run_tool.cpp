@@ -171,6 +171,51 @@ TEST_CASE("sim-run --soak: the closed run alone, with memory and the predictor's
   CHECK_FALSE(std::filesystem::exists(dir / "out/timeline.csv"));
 }
 
+// docs/head.md section 5: a gear play four times the nominal one that the controller is not told
+// of cut the reduction to 3.4x and set the camera hunting across the band; the online estimate
+// (head/backlash_estimate.h) finds it and the compensation takes it.
+TEST_CASE("sim-run: a 2 mrad backlash the controller is not told of is estimated online and the rate still cut 5x",
+          "[tools][sim-run][backlash]") {
+  TempDir dir("sim_run_untold_backlash");
+  const std::string scn = dir.write("backlash.scn", slurp(std::string(EPICHEAD_SOURCE_DIR) + "/sim/scenarios/mockup_walk.scn") +
+                                                        "head_backlash_rad 0.002\n");
+  const auto r = run_epichead(dir, "sim-run '" + scn + "' --out '" + dir.str() +
+                                       "/out' --seconds 10 --mode stabilise --downscale 8 --every 0 --told-backlash-rad 0");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  const auto& c = j["loop"]["controller"];
+  INFO(j["camera_rate_rms_degps"].dump() << " " << c.dump());
+  CHECK(c["backlash_samples"].get<int>() >= 10);
+  for (const char* joint : {"pan", "tilt"}) {
+    const double band = c["backlash_band_rad"][joint].get<double>();
+    CHECK(band > 0.6 * 0.002);  // 0.85 of the estimate
+    CHECK(band <= 0.002);       // never wider than the play: too wide costs more than too narrow
+  }
+  CHECK(j["camera_rate_rms_degps"]["reduction"].get<double>() > 5.0);
+}
+
+// The soak's drift (docs/head.md section 6), in ten seconds: a bus-off 0.1 s into a walking
+// step's burst silences the IMU (it is on the same bus) while the head, without commands, lets
+// the camera swing with the body; the tracker settles on a pose tens of degrees off that it keeps
+// reporting as tracked, and the predictor, its poses gated and then re-initialised from the
+// tracker's, follows it for good. OPEN (issue 22): this reproduces it and fails while the drift is
+// there; [!shouldfail] keeps the suite green until it is fixed, and must then be taken off.
+TEST_CASE("sim-run --soak: after a bus-off inside a step's burst the tracker and the prediction come back to the truth",
+          "[tools][sim-run][soak][!shouldfail]") {
+  TempDir dir("sim_run_bus_off_drift");
+  const std::string scn = dir.write("bus_off.scn", slurp(std::string(EPICHEAD_SOURCE_DIR) + "/sim/scenarios/mockup_walk.scn") +
+                                                       "fault bus_off 6.0 0.3\n");
+  const auto r = run_epichead(dir, "sim-run '" + scn + "' --out '" + dir.str() +
+                                       "/out' --seconds 10 --soak --soak-warmup-s 1 --downscale 2 --every 0");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  INFO(j["soak"].dump());
+  // Measured (seed 1): 2.6 deg early, 81 deg over the last second; the tracker's own error the same.
+  CHECK(j["soak"]["predicted_attitude_error_deg_median_late"].get<double>() < 3.0);
+}
+
 TEST_CASE("sim-run leaves the frames a cover board hides the object in out of the tracking success, as score does",
           "[tools][sim-run]") {
   TempDir dir("sim_run_cover");

@@ -33,6 +33,10 @@ class BacklashCompensator {
   explicit BacklashCompensator(double backlash_rad = 0) : half_rad_(0.5 * backlash_rad) {}
 
   bool active() const { return half_rad_ > 0; }
+  double band_rad() const { return 2 * half_rad_; }
+  // A new width of the band (an online estimate, backlash_estimate.h): the modelled output keeps
+  // its place, clamped into the new band around the motor's last command.
+  void set_band(double backlash_rad, double motor_angle_rad);
   // Forget where the output sits: it is taken as in the middle of the band around the motor
   // angle, direction unknown (start-up, restart from the measured state).
   void reset(double motor_angle_rad);

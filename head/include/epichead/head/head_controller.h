@@ -38,6 +38,7 @@
 #include "epichead/firmware_iface/head_command.h"
 #include "epichead/firmware_iface/head_state.h"
 #include "epichead/head/backlash_compensation.h"
+#include "epichead/head/backlash_estimate.h"
 #include "epichead/head/control_mode.h"
 #include "epichead/head/gyro_attitude.h"
 #include "epichead/head/head_kinematics.h"
@@ -56,6 +57,10 @@ struct HeadControllerOptions {
   // The gear's dead band between motor (encoder) and output (camera) per joint, as measured on
   // the head (docs/head.md); 0 = no compensation. Used in Stabilise and Fixate.
   JointBacklash backlash;
+  // Online estimate of the play at direction reversals (encoder against gyro), per joint: it
+  // widens the band above when the head has more play than it was told (an uncalibrated or worn
+  // gear; backlash_estimate.h).
+  BacklashEstimateOptions backlash_estimate;
   double rate_hz = 1000;                  // nominal control rate: a longer tick is integrated as at most 5 nominal ticks
   double stabilise_gain_per_s = 60;       // optical-axis angle error -> camera rate (1/s)
   double fixate_gain_per_s = 5;           // target angle error -> camera rate (1/s)
@@ -140,6 +145,8 @@ struct HeadCounters {
   std::uint64_t rate_limited = 0, accel_limited = 0, braking_limited = 0, position_limited = 0;  // joint-ticks
   std::uint64_t following_error_clamped = 0;  // joint-ticks the commanded angle was pulled toward the measured one
   std::uint64_t backlash_reversals = 0;     // dead-band crossings started by the compensation (both joints)
+  std::uint64_t backlash_samples = 0;       // reversals that measured the play (both joints)
+  std::uint64_t backlash_samples_rejected = 0;  // crossings too slow or measured outside [0, backlash_estimate.max_rad]
   std::uint64_t encode_clipped = 0;         // command values beyond the wire's range (clipped)
   std::uint64_t events = 0, events_dropped = 0;
 };
@@ -160,6 +167,10 @@ class HeadController {
   const HeadControllerOptions& options() const { return options_; }
   // inertial_R_cam from the gyro (for diagnostics and tests).
   const GyroAttitude& attitude() const { return attitude_; }
+  // The band each joint's compensation uses now: the calibration or, wider, the online estimate.
+  JointBacklash backlash_band() const { return {pan_backlash_.band_rad(), tilt_backlash_.band_rad()}; }
+  const BacklashEstimator& pan_backlash_estimate() const { return pan_play_; }
+  const BacklashEstimator& tilt_backlash_estimate() const { return tilt_play_; }
 
  private:
   explicit HeadController(const HeadControllerOptions& options);
@@ -180,6 +191,7 @@ class HeadController {
   void command_from_head();
   Eigen::Vector2d camera_rate_law(const Eigen::Vector2d& camera_rate_xy_radps) const;
   void update_body_rate();
+  void measure_backlash(bool new_gyro, bool new_head, double gyro_dt_s);
   void emit(ControlOutput& out, const HeadEvent& e);
 
   HeadControllerOptions options_;
@@ -211,6 +223,7 @@ class HeadController {
 
   JointCommand pan_cmd_, tilt_cmd_;       // the last command (internal, continuous angle)
   BacklashCompensator pan_backlash_, tilt_backlash_;  // where each output sits in its dead band
+  BacklashEstimator pan_play_, tilt_play_;            // each joint's play measured online
   Eigen::Vector3d reference_dir_ = Eigen::Vector3d::UnitZ();  // Stabilise: optical axis to hold (inertial)
   JointAngles hold_;                      // Hold target
   bool parked_reported_ = false;

@@ -125,6 +125,7 @@ struct OnboardSummary {
   std::size_t log_frame_queue_high_water = 0, log_line_queue_high_water = 0;
   std::string threads;  // what each thread got: CPU, scheduling policy, memory lock
   HeadCounters controller;
+  JointBacklash backlash_band;  // the band the compensation used at the end: calibrated or estimated online
   ImuAssemblyCounters imu_assembly;
   ClockSyncCounters imu_clock;  // time sync with the IMU: without it no IMU sample can be placed in time
   fusion::PredictorCounters predictor;
