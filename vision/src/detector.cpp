@@ -117,21 +117,20 @@ std::vector<Eigen::Isometry3d> Detector::Impl::hypotheses(const std::vector<cv::
   return out;
 }
 
-DetectionHypothesis Detector::Impl::refine(const Eigen::Isometry3d& start, float similarity, int pull_passes, bool settle) {
+DetectionHypothesis Detector::Impl::refine(const Eigen::Isometry3d& start, float similarity) {
   DetectionHypothesis h;
   h.similarity = similarity;
   h.cam_T_obj = start;
   h.start_cam_T_obj = start;
-  h.status = TrackStatus::Tracked;
   FrameReport report;
   pull.reset();
-  for (int pass = 0; pass < pull_passes; ++pass) {
+  for (int pass = 0; pass + 1 < options.refine_passes; ++pass) {
     pull.track(window_image, h.cam_T_obj, report);
     h.status = report.status;
     if (report.status == TrackStatus::Lost) break;
     h.cam_T_obj = report.cam_T_obj;
   }
-  if (settle && (h.status != TrackStatus::Lost || pull_passes == 0)) {
+  if (h.status != TrackStatus::Lost || options.refine_passes <= 1) {
     tracker.reset();
     tracker.track(window_image, h.cam_T_obj, report);
     h.status = report.status;
@@ -219,7 +218,7 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   // Near the prediction first: when the object is where it was expected, no search is needed.
   if (prior.near_cam_T_obj) {
     const auto t_near = Clock::now();
-    DetectionHypothesis near = d.refine(*prior.near_cam_T_obj, 0.0f, std::max(0, d.options.refine_passes - 1), true);
+    DetectionHypothesis near = d.refine(*prior.near_cam_T_obj, 0.0f);
     result.refine_ms += ms_since(t_near);
     if (d.verified(near)) {
       result.best = near;
@@ -239,26 +238,10 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
   const std::vector<Eigen::Isometry3d> starts = d.hypotheses(matches, prior, similarity);
   result.match_ms = ms_since(t0) - result.refine_ms;
 
-  // Screening: the first few tracking steps from every hypothesis; the best by score (whole
-  // object in view, outline supported) take the rest of the steps from where they were left.
   const auto t1 = Clock::now();
-  const int all_passes = std::max(0, d.options.refine_passes - 1);  // pull steps before the settling one
-  const int screen = std::clamp(d.options.screen_passes, 0, all_passes);
-  std::vector<DetectionHypothesis>& screened = d.screened;
-  screened.clear();
-  for (std::size_t i = 0; i < starts.size(); ++i) screened.push_back(d.refine(starts[i], similarity[i], screen, false));
-  const auto by_score = [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; };
-  std::stable_sort(screened.begin(), screened.end(), by_score);
-  // Only fully refined hypotheses can be the result: they come first, best score first; the
-  // screened rest follow (for --every-hypothesis).
-  const std::size_t refined = std::min(screened.size(), static_cast<std::size_t>(std::max(1, d.options.refined_hypotheses)));
-  for (std::size_t i = 0; i < refined; ++i) {
-    DetectionHypothesis h = d.refine(screened[i].cam_T_obj, screened[i].similarity, all_passes - screen, true);
-    h.start_cam_T_obj = screened[i].start_cam_T_obj;
-    result.hypotheses.push_back(h);
-  }
-  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(), by_score);
-  result.hypotheses.insert(result.hypotheses.end(), screened.begin() + static_cast<std::ptrdiff_t>(refined), screened.end());
+  for (std::size_t i = 0; i < starts.size(); ++i) result.hypotheses.push_back(d.refine(starts[i], similarity[i]));
+  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(),
+                   [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
   result.refine_ms += ms_since(t1);
   for (DetectionHypothesis& h : result.hypotheses) d.choose_symmetric(h, prior);
   if (!result.hypotheses.empty()) {

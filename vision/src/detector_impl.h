@@ -71,7 +71,6 @@ struct Detector::Impl {
   double radius_m = 0;
   std::vector<Eigen::Vector3d> outline_obj;  // model points whose projections stand for a pose's outline
   std::vector<Eigen::Vector2d> scratch_outline;
-  std::vector<DetectionHypothesis> screened;  // detect()'s, kept to reuse its memory
   // The model's own symmetries (model_symmetry.h): poses that differ by one draw the same
   // outline, so the search cannot choose among them; the prior can (choose_symmetric).
   std::vector<Eigen::Isometry3d> symmetries;
@@ -103,9 +102,7 @@ struct Detector::Impl {
   std::vector<std::string> classes_for(const DetectionPrior& prior) const;
   std::vector<Eigen::Isometry3d> hypotheses(const std::vector<cv::linemod::Match>& matches, const DetectionPrior& prior,
                                             std::vector<float>& similarity);
-  // pull_passes tracking steps with the wide pull from `start`, then, when settle, one step as
-  // tracking takes it; then measure().
-  DetectionHypothesis refine(const Eigen::Isometry3d& start, float similarity, int pull_passes, bool settle);
+  DetectionHypothesis refine(const Eigen::Isometry3d& start, float similarity);
   // Support, score and outline length of h's pose on the current frame (gradients).
   // whole_object: a pose with part of the model outside the image scores 0 (detections).
   DetectionHypothesis measure(DetectionHypothesis h, bool whole_object = true);

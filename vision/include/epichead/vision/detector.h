@@ -52,12 +52,6 @@ struct DetectorOptions {
   int max_hypotheses = 48;
   double duplicate_px = 8.0;  // hypotheses whose projected model points lie this close are one
   int refine_passes = 8;  // tracking steps on the frame from each hypothesis
-  // Each hypothesis is screened first by screen_passes of those steps; only the best
-  // refined_hypotheses by score then take the rest of them. Refining all 48 to the end took
-  // most of a search's time, and one that is not among the best after the screening has not
-  // been seen to win (the screening pulls a template's pose most of the way in).
-  int screen_passes = 2;
-  int refined_hypotheses = 8;
   // A detection is reported found when at least this share of the projected model's edge
   // samples has an image edge of its orientation within support_radius_px.
   double min_support = 0.55;
