@@ -73,10 +73,7 @@ struct PoseOptions {
   double min_scale_px = 1.0;         // floor of the robust scale, in units of each feature's sigma
   double outlier_sigma = 3.0;        // a feature whose RMS residual exceeds this many scales is an outlier
   double max_condition = 1e10;       // larger condition number of the normal matrix = degenerate
-  // Stop when the update's norm (m and rad) falls below this: a thousandth of what a frame's
-  // pose is known to (~1 mm, ~1 mrad), so further steps only polish noise. 1e-10 before cost a
-  // quarter more iterations with no change to the poses beyond micrometres (docs/performance.md).
-  double convergence_step = 1e-6;
+  double convergence_step = 1e-10;   // stop when the update's norm falls below this
   // Floor of the residual noise the covariance is scaled by, in units of each feature's sigma.
   double min_noise_sigma = 0.25;
   // The error every edgel of a line shares, in pixels (1-sigma), both as a shift of the whole
