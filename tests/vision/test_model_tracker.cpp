@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -143,4 +145,121 @@ TEST_CASE("reasons print as a readable list") {
   CHECK(to_string(TrackReason::None).empty());
   CHECK(to_string(TrackReason::FewFeatures | TrackReason::PoseFailed) == "few_features+pose_failed");
   CHECK(std::string(to_string(TrackStatus::Degraded)) == "degraded");
+}
+
+namespace {
+
+// The cube with a disc printed on the face most towards the camera at pose_at(0): a model
+// circle, tracked as an ellipse by the full tracker.
+CadModel cube_with_disc(Eigen::Vector3d& disc_centre, Eigen::Vector3d& disc_normal, double& disc_radius) {
+  RawModel raw;
+  const double h = 0.05;
+  raw.vertices = {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h}, {-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h}};
+  raw.face_loops = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+  const CadModel plain = *build_model(raw, "cube");
+  double best = 0;
+  for (const ModelFace& f : plain.faces) {
+    const Eigen::Vector3d p = plain.vertices[static_cast<std::size_t>(f.vertices[0])];
+    const double towards = -(pose_at(0).linear() * f.normal_obj).dot((pose_at(0) * p).normalized());
+    if (towards > best) {
+      best = towards;
+      disc_normal = f.normal_obj;
+    }
+  }
+  disc_centre = h * disc_normal;
+  disc_radius = 0.03;
+  raw.circles.push_back({disc_centre, disc_normal, disc_radius});
+  return *build_model(raw, "cube with disc");
+}
+
+// Draws a filled model-space circle and, when board_x_px is finite, a grey board covering every
+// pixel right of it, over a rendered frame (at the frame's own resolution, blurred like it).
+cv::Mat with_disc_and_board(cv::Mat img, const Camera& cam, const Eigen::Isometry3d& cam_T_obj,
+                            const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius, double board_x_px) {
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  std::vector<cv::Point> poly;
+  for (int i = 0; i < 128; ++i) {
+    const double a = 2 * M_PI * i / 128;
+    const Eigen::Vector2d px = cam.project(cam_T_obj * (centre + radius * (std::cos(a) * u + std::sin(a) * v)));
+    poly.emplace_back(cvRound(px.x() * 16), cvRound(px.y() * 16));
+  }
+  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(235, 235, 235), cv::LINE_AA, 4);
+  if (std::isfinite(board_x_px))
+    cv::rectangle(img, cv::Point(static_cast<int>(board_x_px), 0), cv::Point(img.cols, img.rows), cv::Scalar(110, 110, 110), cv::FILLED);
+  cv::GaussianBlur(img, img, cv::Size(0, 0), 0.7);
+  return img;
+}
+
+// Three frames in full view, six with a board over the right third of the disc's image (the
+// cube's edges left of it stay in view), then up to ten without the board; the camera moves
+// as in the cube tests. What the full tracker did with the circle, frame by frame.
+struct CoveredDiscRun {
+  double worst_rotation_deg = 0, worst_translation_mm = 0;
+  int full_before = 0;            // of the 3 frames before the board, the ellipse found all round
+  bool arc_seen = false;          // under the board, the ellipse found as an arc
+  int arc_lines_under_board = 0;  // arc lines placed more than 3 px onto the board
+  int occlusions = 0, recoveries = 0;
+  int frames_to_full = -1;        // after the board left, frames until the ellipse was whole again
+};
+
+CoveredDiscRun run_covered_disc() {
+  Eigen::Vector3d centre, normal;
+  double radius = 0;
+  const CadModel model = cube_with_disc(centre, normal, radius);
+  REQUIRE(model.circles.size() == 1u);
+  const Camera cam = test_camera();
+  ModelTracker tracker(model, cam);
+  WindowImage image;
+  FrameReport report;
+  const Eigen::Vector2d disc_px = cam.project(pose_at(0) * centre);
+  const double disc_width_px = 2 * radius * cam.intrinsics().fx_px / (pose_at(0) * centre).z();
+  const double board_x_px = disc_px.x() + disc_width_px / 6;
+  CoveredDiscRun run;
+  Eigen::Isometry3d predicted = pose_at(0);
+  int k = 0;
+  auto step = [&](bool board) -> const EllipseFeature& {
+    const Eigen::Isometry3d truth = pose_at(k++);
+    REQUIRE(image.assign(with_disc_and_board(render(model, cam, truth, true), cam, truth, centre, normal, radius,
+                                             board ? board_x_px : std::numeric_limits<double>::infinity())));
+    tracker.track(image, predicted, report);
+    predicted = report.cam_T_obj;
+    run.worst_rotation_deg = std::max(run.worst_rotation_deg, rotation_error_deg(report.cam_T_obj, truth));
+    run.worst_translation_mm = std::max(run.worst_translation_mm, 1e3 * (report.cam_T_obj.translation() - truth.translation()).norm());
+    REQUIRE(tracker.ellipses().features().size() == 1u);
+    return tracker.ellipses().features().front();
+  };
+  for (int i = 0; i < 3; ++i) run.full_before += step(false).arc.full() && report.ellipses_found == 1;
+  for (int i = 0; i < 6; ++i) {
+    const EllipseFeature& f = step(true);
+    if (!f.found || f.arc.full()) continue;
+    run.arc_seen = true;
+    for (int r = f.arc_row_begin; r < f.arc_row_end; ++r) run.arc_lines_under_board += f.lines[r].centre_px.x() > board_x_px + 3.0;
+  }
+  for (int i = 0; i < 10 && run.frames_to_full < 0; ++i)
+    if (step(false).arc.full()) run.frames_to_full = i + 1;
+  run.occlusions = tracker.ellipses().features().front().occlusions;
+  run.recoveries = tracker.ellipses().features().front().recoveries;
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("the full tracker keeps tracking while a board covers part of a circle, seen as an arc") {
+  const CoveredDiscRun run = run_covered_disc();
+  CHECK(run.full_before == 3);
+  CHECK(run.arc_seen);
+  CHECK(run.occlusions >= 1);
+  CHECK(run.worst_rotation_deg < 1.0);
+  CHECK(run.worst_translation_mm < 5.0);
+}
+
+// Known gap (issue 19 item 6): EllipseTracker on its own re-spreads the arc's lines onto the part
+// in view and grows the arc back within ten frames (test_ellipse_tracker.cpp), but inside the
+// full tracker the arc's lines stay 5-17 px onto the board and the ellipse never becomes whole
+// again. Take [!shouldfail] off when fixed.
+TEST_CASE("the full tracker places the arc's lines on the part in view and recovers the whole ellipse after", "[!shouldfail]") {
+  const CoveredDiscRun run = run_covered_disc();
+  CHECK(run.arc_lines_under_board == 0);
+  CHECK(run.frames_to_full > 0);
+  CHECK(run.recoveries >= 1);
 }
