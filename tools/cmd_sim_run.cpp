@@ -114,7 +114,7 @@ bool write_overlay(const head::TrackedFrame& f, const vision::CadModel& model, c
   const vision::VisibleModel vis = vision::compute_visibility(model, cam, f.report->cam_T_obj);
   vision::draw_visible_model(canvas, vis);
   char caption[128];
-  std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.report->status),
+  std::snprintf(caption, sizeof caption, "t %.3f s  %s  lines %d/%d", f.exposure_t_s, vision::to_string(f.status),
                 f.report->inliers, f.report->visible);
   cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3, cv::LINE_AA);  // legible on light scenes
   cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
@@ -216,7 +216,7 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
       if (m.attitude_errors < m.attitude_error_deg.size()) {
         const Eigen::Matrix3d dt = f.report->cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
         m.tracked_attitude_error_deg[m.attitude_errors] =
-            f.report->status == vision::TrackStatus::Lost ? std::nan("") : Eigen::AngleAxisd(dt).angle() * 180 / M_PI;
+            f.status == vision::TrackStatus::Lost ? std::nan("") : Eigen::AngleAxisd(dt).angle() * 180 / M_PI;
         m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
       }
     }
@@ -226,7 +226,7 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
     ++m.hidden;
     return;
   }
-  if (f.report->status != vision::TrackStatus::Lost) {
+  if (f.status != vision::TrackStatus::Lost) {
     if (auto truth = w.truth_at(f.exposure_t_s)) {
       bool success = false;
       for (std::size_t k = 0; k <= symmetries.size() && !success; ++k) {

@@ -268,6 +268,7 @@ struct TrackCounts {
   int searched_frames = 0;  // before detection found the start
   int fused_frames = 0;     // frames whose poses.csv row is the filter's estimate
   int fallback_frames = 0;  // frames measured from the vision-only extrapolation
+  int against_gravity = 0;  // tracked poses taken as lost: their tilt contradicts the accelerometer
 };
 
 // report.json's summary (per-frame entries and acquisition are added by the caller).
@@ -288,6 +289,7 @@ nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const Trac
   j["searched_frames"] = c.searched_frames;
   j["fused_frames"] = c.fused_frames;
   j["fallback_frames"] = c.fallback_frames;
+  j["against_gravity_frames"] = c.against_gravity;
   if (tracker.free_turn()) {
     const auto& a = *tracker.free_turn();
     j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
@@ -367,6 +369,13 @@ int run_track(const TrackArgs& args) {
     const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
     const std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
+    // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
+    // (a printed band, clutter), however well the image supports it: lost, so that detection runs.
+    if (report.status != TrackStatus::Lost && (*predictor)->against_gravity(entry.t_s, report.cam_T_obj)) {
+      report.status = TrackStatus::Lost;
+      report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
+      ++counts.against_gravity;
+    }
     if (auto ok = acquisition.after_tracking(*frame, image, entry.t_s, predicted, tracker, **predictor, report); !ok)
       return fail(cmd, ok.error());
     counts.fallback_frames += report.used_fallback;
@@ -379,12 +388,21 @@ int run_track(const TrackArgs& args) {
     // blurred lines is weighed against the gyro's propagation (box_clutter at jerk 2: 98 -> 100 %).
     // The pose estimator's own result stays in vision_poses.csv.
     Eigen::Isometry3d estimate = report.cam_T_obj;
-    if (report.status != TrackStatus::Lost)
+    const char* status = to_string(report.status);
+    if (report.status != TrackStatus::Lost) {
       if (const auto f = (*predictor)->fused(entry.t_s)) {
         estimate = *f;
         ++counts.fused_frames;
       }
-    poses.push_back({entry.frame, entry.t_s, estimate, to_string(report.status)});
+    } else if (has(report.reasons, vision::TrackReason::AgainstGravity)) {
+      // The image's pose was a wrong lock; the IMU's propagation is still an estimate, a doubtful one.
+      if (const auto f = (*predictor)->fused(entry.t_s)) {
+        estimate = *f;
+        status = to_string(TrackStatus::Degraded);
+        ++counts.fused_frames;
+      }
+    }
+    poses.push_back({entry.frame, entry.t_s, estimate, status});
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
     if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));

@@ -33,6 +33,7 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                                           {"detections_found", s.detections_found},
                                           {"losses", s.losses},
                                           {"reacquisitions", s.reacquisitions},
+                                          {"against_gravity", s.against_gravity},
                                           {"first_detection_t_s", s.first_detection_t_s},
                                           {"detect_ms_max", s.detect_ms_max}}},
                          {"queue_high_water", {{"vision_jobs", s.frames ? 1 : 0},

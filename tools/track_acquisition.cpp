@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace epichead::tools {
 
@@ -13,7 +14,7 @@ TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::Mo
 
 std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::detect(
     const cv::Mat& frame, double t_s, const std::optional<Eigen::Isometry3d>& near,
-    const std::optional<Eigen::Isometry3d>& orient_like) {
+    const std::optional<Eigen::Isometry3d>& orient_like, const std::optional<Upright>& upright) {
   if (!detector_) {
     auto d = make_detector("track", seq_->model(), seq_->camera(), options_.detection, tracking_);
     if (!d) return std::unexpected(d.error());
@@ -25,6 +26,9 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
   if (options_.use_imu_gravity && up_obj_) {
     prior.up_obj = up_obj_;
     prior.up_cam = up_from_imu(seq_->imu(), t_s);
+  } else if (upright) {
+    prior.up_obj = upright->up_obj;
+    prior.up_cam = upright->up_cam;
   }
   const auto t0 = std::chrono::steady_clock::now();
   auto r = detector_->detect(frame, prior);
@@ -60,8 +64,16 @@ bool TrackAcquisition::after_frame(vision::TrackStatus status) {
 }
 
 std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_again(const cv::Mat& frame, double t_s,
-                                                                                          const Eigen::Isometry3d& predicted) {
-  auto r = detect(frame, t_s, predicted);
+                                                                                          const Eigen::Isometry3d& predicted,
+                                                                                          const std::optional<Upright>& upright) {
+  // A prediction that tilts the object away (the filter after an IMU gap, or a lock it took) is
+  // no place to look near.
+  std::optional<Eigen::Isometry3d> near = predicted;
+  if (upright) {
+    const Eigen::Vector3d u = predicted.linear() * upright->up_obj;
+    if (std::atan2(u.cross(upright->up_cam).norm(), u.dot(upright->up_cam)) > upright->max_tilt_rad) near.reset();
+  }
+  auto r = detect(frame, t_s, near, {}, upright);
   if (r && *r) {
     ++reacquired_;
     provisional_from(t_s);
@@ -98,7 +110,7 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
                                                                   vision::FrameReport& report) {
   std::optional<Eigen::Isometry3d> found;
   if (after_frame(report.status)) {
-    auto again = find_again(frame, t_s, predicted);
+    auto again = find_again(frame, t_s, predicted, predictor.upright(t_s));
     if (!again) return std::unexpected(again.error());
     found = *again;
   } else if (report.status != vision::TrackStatus::Lost && recheck_due(t_s)) {

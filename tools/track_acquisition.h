@@ -45,8 +45,11 @@ class TrackAcquisition {
   // frame (lost for lost_frames_before_detection frames in a row, and re-acquisition on).
   bool after_frame(vision::TrackStatus status);
   // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
+  // With `upright` (the IMU's learnt down) the search keeps upright poses only, and skips the
+  // predicted pose when that tilts the object away.
   std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, double t_s,
-                                                                          const Eigen::Isometry3d& predicted);
+                                                                          const Eigen::Isometry3d& predicted,
+                                                                          const std::optional<Upright>& upright = {});
   // After the frame's tracking step (report): detection when the object has been lost for a few
   // frames (near `predicted` first), and the provisional start's recheck. When either finds a
   // pose, the tracker and the predictor restart from it and the frame is measured again.
@@ -67,7 +70,8 @@ class TrackAcquisition {
   }
   std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
                                                                       const std::optional<Eigen::Isometry3d>& near,
-                                                                      const std::optional<Eigen::Isometry3d>& orient_like = {});
+                                                                      const std::optional<Eigen::Isometry3d>& orient_like = {},
+                                                                      const std::optional<Upright>& upright = {});
   const vision::Sequence* seq_;
   vision::ModelTrackerOptions tracking_;
   AcquisitionOptions options_;

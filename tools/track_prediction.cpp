@@ -211,6 +211,16 @@ class ImuPredictor final : public TrackPredictor {
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;  // nothing before the filter starts
     return std::nullopt;
   }
+  bool against_gravity(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+    feed_until(t_s);
+    return predictor_.check_tilt(t_s, cam_T_obj);
+  }
+  std::optional<Upright> upright(double t_s) const override {
+    const auto down_cam = predictor_.measured_down_cam(t_s);
+    const auto down_obj = predictor_.learnt_down_obj();
+    if (!down_cam || !down_obj) return std::nullopt;
+    return Upright{-*down_cam, -*down_obj, options_.gravity_check.max_tilt_error_rad};
+  }
   nlohmann::json diagnostics() const override {
     const auto st = predictor_.status(last_good_t_s_);
     const auto& c = st.counters;
@@ -233,6 +243,9 @@ class ImuPredictor final : public TrackPredictor {
             {"vision_gated", c.vision_gated},
             {"vision_too_old", c.vision_too_old},
             {"reinitialisations", c.reinitialisations},
+            {"gravity_learnt", st.gravity_learnt},
+            {"vision_against_gravity", c.vision_against_gravity},
+            {"gravity_forgotten", c.gravity_forgotten},
             {"resets_after_loss", resets_},
             {"restarts_from_fallback", fallback_restarts_},
             {"weak_poses_after_loss", weak_reacquisitions_},
@@ -288,6 +301,7 @@ class ImuPredictor final : public TrackPredictor {
     if (!p) return;  // options were valid once; only the offset changed
     // The velocity, biases and gravity learnt so far carry over; only the clock changes.
     if (const auto motion = predictor_.state()) p->carry_motion(*motion, predictor_.covariance());
+    p->carry_learnt_gravity(predictor_);
     predictor_ = std::move(*p);
     const auto& imu = *imu_;
     next_ = 0;

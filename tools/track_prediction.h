@@ -15,6 +15,13 @@
 
 namespace epichead::tools {
 
+// The world's up in the camera frame and the object's up in its own (unit vectors), and how far a
+// pose may tilt from them before it counts as a wrong lock.
+struct Upright {
+  Eigen::Vector3d up_cam, up_obj;
+  double max_tilt_rad = 0;
+};
+
 class TrackPredictor {
  public:
   virtual ~TrackPredictor() = default;
@@ -29,6 +36,18 @@ class TrackPredictor {
   // A second opinion for a frame the tracker loses from predict(t_s): the vision poses
   // extrapolated alone, when the predictor is more than that (the IMU); nothing otherwise.
   virtual std::optional<Eigen::Isometry3d> fallback(double t_s) { (void)t_s; return std::nullopt; }
+  // With the IMU: true when a tracked pose exposed at t_s tilts the object away from the down the
+  // accelerometer measures (fusion::Predictor::check_tilt): a wrong lock, to be taken as lost.
+  virtual bool against_gravity(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+    (void)t_s;
+    (void)cam_T_obj;
+    return false;
+  }
+  // With the IMU and the object's down learnt: which way is up at t_s, for detection.
+  virtual std::optional<Upright> upright(double t_s) const {
+    (void)t_s;
+    return std::nullopt;
+  }
   // Detection found the object again at t_s (after a loss): predictions restart from this pose
   // at rest, as from init.csv.
   virtual void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) = 0;

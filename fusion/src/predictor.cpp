@@ -49,6 +49,11 @@ std::expected<void, std::string> check(const PredictorOptions& o) {
   if (!positive(o.initial_gravity_rad) || !positive(o.initial_speed_mps) || !positive(o.initial_gyro_bias_radps) ||
       !positive(o.initial_accel_bias_mps2))
     return bad("initial_*", "must be > 0");
+  const GravityCheckOptions& g = o.gravity_check;
+  if (g.learn_after_applied < 1 || !positive(g.learn_sigma_rad) || !positive(g.learn_time_s) || !positive(g.window_s) ||
+      !non_negative(g.min_window_s) || g.min_window_s > g.window_s || !positive(g.max_tilt_error_rad) ||
+      !positive(g.forget_after_s))
+    return bad("gravity_check", "needs learn_after_applied >= 1, 0 <= min_window_s <= window_s and the rest finite and > 0");
   const ConstantVelocityNoise& c = o.cv_noise;
   if (!positive(c.accel_mps2_rths) || !positive(c.angular_accel_radps2_rths) || !positive(c.initial_speed_mps) ||
       !positive(c.initial_rate_radps))
@@ -81,6 +86,7 @@ const char* to_string(VisionVerdict v) {
     case VisionVerdict::OutOfOrder: return "out-of-order";
     case VisionVerdict::BadInput: return "bad-input";
     case VisionVerdict::NoImu: return "no-imu";
+    case VisionVerdict::AgainstGravity: return "against-gravity";
   }
   return "?";
 }
@@ -90,7 +96,8 @@ std::expected<Predictor, std::string> Predictor::create(const PredictorOptions& 
   return Predictor(options);
 }
 
-Predictor::Predictor(const PredictorOptions& options) : options_(options), imu_(options), cv_(options.cv_noise) {}
+Predictor::Predictor(const PredictorOptions& options)
+    : options_(options), imu_(options), cv_(options.cv_noise), gravity_(options.gravity_check) {}
 
 PoseFilter& Predictor::filter() {
   if (options_.mode == PredictorMode::ConstantVelocity) return cv_;
@@ -172,6 +179,9 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   const Matrix6d cov = 0.5 * (cov_in + cov_in.transpose());
   PoseFilter& f = filter();
   if (!initialised_ || reinit_pending_) {
+    // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
+    // about to be replaced, may be the one that is wrong).
+    if (check_tilt(t_s, cam_T_obj)) return {VisionVerdict::AgainstGravity, 0};
     if (!f.initialise(t_s, cam_T_obj, cov)) {
       ++c.vision_no_imu;
       return {VisionVerdict::NoImu, 0};
@@ -181,6 +191,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     initialised_ = true;
     reinit_pending_ = false;
     status_.gated_in_a_row = 0;
+    applied_in_a_row_ = 0;
     status_.last_update_t_s = t_s;
     return {VisionVerdict::Initialised, 0};
   }
@@ -196,6 +207,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   }
   if (!r->applied) {
     ++c.vision_gated;
+    applied_in_a_row_ = 0;
     if (++status_.gated_in_a_row >= options_.reinit_after_gated) reinit_pending_ = true;
     return {VisionVerdict::Gated, r->mahalanobis2};
   }
@@ -203,7 +215,53 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   status_.gated_in_a_row = 0;
   status_.last_nis = r->mahalanobis2;
   status_.last_update_t_s = t_s;
+  ++applied_in_a_row_;
+  if (options_.mode == PredictorMode::ImuAided)
+    if (const StateEntry* e = imu_.newest_state()) {
+      const double sigma = std::sqrt(e->P.block<2, 2>(err::grav, err::grav).diagonal().maxCoeff());
+      gravity_.learn(t_s, e->x.gravity_obj_mps2(), sigma, e->x.gyro_bias_radps, e->x.accel_bias_mps2, applied_in_a_row_);
+    }
   return {VisionVerdict::Applied, r->mahalanobis2};
+}
+
+std::optional<Eigen::Vector3d> Predictor::measured_down_cam(double t_s) const {
+  if (options_.mode != PredictorMode::ImuAided || !finite(t_s)) return std::nullopt;
+  // The biases learnt with the down, else the newest state's, else none (a fraction of a degree
+  // over the window either way).
+  Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero();
+  if (gravity_.learnt()) {
+    bg = gravity_.gyro_bias_radps();
+    ba = gravity_.accel_bias_mps2();
+  } else if (const StateEntry* e = imu_.newest_state()) {
+    bg = e->x.gyro_bias_radps;
+    ba = e->x.accel_bias_mps2;
+  }
+  const GravityCheckOptions& o = options_.gravity_check;
+  const std::optional<Eigen::Vector3d> down_imu =
+      measured_down_imu(imu_.history(), t_s, o.window_s, o.min_window_s, options_.dropout_gap_s, bg, ba);
+  if (!down_imu) return std::nullopt;
+  return options_.mount.cam_R_imu * *down_imu;
+}
+
+std::optional<Eigen::Vector3d> Predictor::learnt_down_obj() const {
+  if (!gravity_.learnt()) return std::nullopt;
+  return gravity_.down_obj();
+}
+
+std::optional<double> Predictor::tilt_error_rad(double t_s, const Eigen::Isometry3d& cam_T_obj) const {
+  if (!gravity_.learnt() || !cam_T_obj.matrix().allFinite()) return std::nullopt;
+  return gravity_.tilt_error_rad(cam_T_obj.linear(), measured_down_cam(t_s));
+}
+
+bool Predictor::check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+  const std::optional<double> e = tilt_error_rad(t_s, cam_T_obj);
+  if (!e) return false;
+  const bool against = *e > options_.gravity_check.max_tilt_error_rad;
+  const int forgotten = gravity_.forgotten();
+  gravity_.note_verdict(t_s, against);
+  status_.counters.gravity_forgotten += static_cast<std::uint64_t>(gravity_.forgotten() - forgotten);
+  if (against) ++status_.counters.vision_against_gravity;
+  return against;
 }
 
 std::optional<PosePrediction> Predictor::predict(double t_s) const {
@@ -214,6 +272,7 @@ std::optional<PosePrediction> Predictor::predict(double t_s) const {
 PredictorStatus Predictor::status(double now_t_s) const {
   PredictorStatus s = status_;
   s.initialised = initialised_;
+  s.gravity_learnt = gravity_.learnt();
   s.coasting = initialised_ && options_.mode == PredictorMode::ImuAided &&
                (imu_.history().empty() || !(now_t_s - status_.newest_imu_t_s <= options_.coast_after_s));
   s.counters.repropagated_samples = imu_.repropagated_samples();

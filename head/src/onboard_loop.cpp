@@ -178,6 +178,21 @@ struct OnboardLoop::Impl {
     // No start yet, or lost for a few frames: the stage looks for the object instead.
     job.detect = detector && (!have_pose || lost_run >= options.lost_frames_before_detection);
     job.detect_near = job.detect && have_pose;
+    job.up_cam.reset();
+    job.up_obj.reset();
+    if (job.detect) {
+      // With the down learnt while tracking, the search keeps only poses upright as the object
+      // stands, and a prediction that itself tilts the object away (after an IMU gap) is no place
+      // to look near.
+      const auto down_cam = predictor.measured_down_cam(exposure);
+      const auto down_obj = predictor.learnt_down_obj();
+      if (down_cam && down_obj) {
+        job.up_cam = -*down_cam;
+        job.up_obj = -*down_obj;
+        if (prediction && predictor.tilt_error_rad(exposure, prediction->cam_T_obj) > options.predictor.gravity_check.max_tilt_error_rad)
+          job.detect_near = false;
+      }
+    }
     frame_age_ms.push(1e3 * (now_s - exposure));
     vision.submit(now_s);
     return true;
@@ -196,16 +211,25 @@ struct OnboardLoop::Impl {
     const vision::FrameReport& report = *r->report;
     if (!r->detection) track_ms.push(r->track_ms);  // a detection is timed apart (detect_ms_max)
     ++summary.frames;
-    (report.status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
+    // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
+    // (a printed edge, clutter), however well the image supports it: the frame counts as lost,
+    // so that detection runs after a few, and neither the predictor nor the controller takes it.
+    vision::TrackStatus status = report.status;
+    const bool against_gravity = status != vision::TrackStatus::Lost && predictor.check_tilt(r->exposure_t_s, report.cam_T_obj);
+    if (against_gravity) {
+      status = vision::TrackStatus::Lost;
+      ++summary.against_gravity;
+    }
+    (status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
     // Inline: at the modelled time the stage set; Thread: now, when the control thread takes it.
     const double published = options.threads == VisionThreads::Inline ? r->done_t_s : now_s;
     const double latency_ms = 1e3 * (published - r->exposure_t_s);
     vision_latency_ms.push(latency_ms);
     vision_latency_ms_max = std::max(vision_latency_ms_max, latency_ms);
-    if (hook) hook({summary.frames - 1, r->exposure_t_s, published, r->predicted, &report, r->tracker, r->image});
-    last_status = report.status;
-    count_acquisition(*r, report.status);
-    if (r->detection && r->found && report.status != vision::TrackStatus::Lost) {
+    if (hook) hook({summary.frames - 1, r->exposure_t_s, published, r->predicted, &report, r->tracker, r->image, status, against_gravity});
+    last_status = status;
+    count_acquisition(*r, status, against_gravity);
+    if (r->detection && r->found && status != vision::TrackStatus::Lost) {
       // Found by detection: the predictor starts again from this pose, as from a start pose.
       predictor.reset();
       last_good = report.cam_T_obj;
@@ -218,7 +242,7 @@ struct OnboardLoop::Impl {
       vision.release();
       return;
     }
-    if (report.status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
+    if (status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
       predictor.add_vision(r->exposure_t_s, report.cam_T_obj, report.covariance);
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
@@ -228,11 +252,11 @@ struct OnboardLoop::Impl {
     vision.release();
   }
 
-  void count_acquisition(const VisionResult& r, vision::TrackStatus status) {
+  void count_acquisition(const VisionResult& r, vision::TrackStatus status, bool against_gravity) {
     if (r.detection) {
       ++summary.detections;
       summary.detect_ms_max = std::max(summary.detect_ms_max, r.track_ms);
-      if (r.found) {
+      if (r.found && !against_gravity) {
         ++summary.detections_found;
         if (have_pose) ++summary.reacquisitions;
         if (summary.first_detection_t_s < 0) summary.first_detection_t_s = r.exposure_t_s;

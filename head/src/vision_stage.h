@@ -17,6 +17,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,6 +43,9 @@ struct VisionJob {
   // Find the object instead of tracking it (the stage's detector): near `predicted` first when
   // detect_near, else over the whole search.
   bool detect = false, detect_near = false;
+  // The world's up in the camera frame and the object's in its own (both known: the detection
+  // keeps only poses that agree with them).
+  std::optional<Eigen::Vector3d> up_cam, up_obj;
 };
 
 // What the stage gives back; valid from poll() until release().

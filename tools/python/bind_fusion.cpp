@@ -30,7 +30,8 @@ py::dict counters_dict(const PredictorCounters& c) {
                   py::arg("vision_initialised") = c.vision_initialised, py::arg("vision_gated") = c.vision_gated,
                   py::arg("vision_too_old") = c.vision_too_old, py::arg("vision_out_of_order") = c.vision_out_of_order,
                   py::arg("vision_bad_input") = c.vision_bad_input, py::arg("vision_no_imu") = c.vision_no_imu,
-                  py::arg("reinitialisations") = c.reinitialisations,
+                  py::arg("vision_against_gravity") = c.vision_against_gravity,
+                  py::arg("gravity_forgotten") = c.gravity_forgotten, py::arg("reinitialisations") = c.reinitialisations,
                   py::arg("repropagated_samples") = c.repropagated_samples);
 }
 

@@ -59,7 +59,8 @@ std::string to_string(TrackReason reasons) {
       {TrackReason::NotVisible, "not_visible"}, {TrackReason::FewFeatures, "few_features"},
       {TrackReason::PoseFailed, "pose_failed"}, {TrackReason::FewInliers, "few_inliers"},
       {TrackReason::HighResidual, "high_residual"}, {TrackReason::Jump, "jump"},
-      {TrackReason::Reacquired, "reacquired"}};
+      {TrackReason::Reacquired, "reacquired"},
+      {TrackReason::AgainstGravity, "against_gravity"}};
   std::string s;
   for (const auto& [bit, name] : names) {
     if (!has(reasons, bit)) continue;

@@ -18,6 +18,7 @@
 #include "epichead/fusion/constant_velocity.h"
 #include "epichead/fusion/imu_filter.h"
 #include "epichead/fusion/imu_sample.h"
+#include "epichead/fusion/learnt_gravity.h"
 #include "epichead/fusion/nav_state.h"
 #include "epichead/fusion/pose_filter.h"
 #include "epichead/fusion/pose_prediction.h"
@@ -48,6 +49,8 @@ enum class VisionVerdict {
   BadInput,     // non-finite pose or covariance, covariance not positive definite, or an
                 // exposure time more than buffer_s after the newest sample
   NoImu,        // ImuAided: no accelerometer reading near the exposure time to initialise gravity
+  AgainstGravity,  // ImuAided: a (re-)initialisation refused, the pose's tilt contradicts the
+                   // learnt down (learnt_gravity.h)
 };
 
 const char* to_string(ImuVerdict verdict);
@@ -66,6 +69,8 @@ struct PredictorCounters {
   double dropout_total_s = 0;        // summed length of those gaps
   std::uint64_t vision_applied = 0, vision_initialised = 0, vision_gated = 0, vision_too_old = 0,
                 vision_out_of_order = 0, vision_bad_input = 0, vision_no_imu = 0;
+  std::uint64_t vision_against_gravity = 0;  // poses check_tilt() or a re-initialisation found tilted
+  std::uint64_t gravity_forgotten = 0;       // learnt downs forgotten after a long run of contradictions
   std::uint64_t reinitialisations = 0;  // initialisations after the first (reset or gated run)
   std::uint64_t repropagated_samples = 0;
 };
@@ -77,6 +82,7 @@ struct PredictorStatus {
   double last_update_t_s = 0;      // exposure time of the last applied or initialising pose
   double last_nis = 0;             // normalised innovation squared of the last applied pose (6 dof)
   int gated_in_a_row = 0;
+  bool gravity_learnt = false;     // check_tilt() can tell a tilted pose
   PredictorCounters counters;
 };
 
@@ -89,6 +95,19 @@ class Predictor {
   VisionResult add_vision(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
   // The pose at t_s (camera clock); empty before initialisation or before the oldest kept state.
   std::optional<PosePrediction> predict(double t_s) const;
+  // The down (unit) the accelerometer measures in the camera frame at t_s (learnt_gravity.h); empty
+  // in Mode::ConstantVelocity or without enough recent samples.
+  std::optional<Eigen::Vector3d> measured_down_cam(double t_s) const;
+  // The object's down in its own frame, learnt while vision and the IMU agreed; empty before.
+  std::optional<Eigen::Vector3d> learnt_down_obj() const;
+  // How far a pose exposed at t_s tilts the object's learnt down from the down the accelerometer
+  // measures then (rad); empty in Mode::ConstantVelocity, before a down is learnt, or without
+  // enough recent samples. Kept across reset().
+  std::optional<double> tilt_error_rad(double t_s, const Eigen::Isometry3d& cam_T_obj) const;
+  // True when that error exceeds options().gravity_check.max_tilt_error_rad: the tracker's pose is
+  // a wrong lock whatever its support; the caller takes the frame as lost (and detects again).
+  // Counted, and a long run of them forgets the learnt down (the object was moved).
+  bool check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj);
   PredictorStatus status(double now_t_s) const;
   // Forgets the state (not the buffered samples): the next pose initialises again.
   void reset();
@@ -98,6 +117,9 @@ class Predictor {
   // defaults in the middle of a shake initialises gravity from moving readings and the velocity
   // as unknown, and the translation runs off before vision can pull it back (box_clutter).
   void carry_motion(const NavState& motion, const ErrorCovariance& covariance);
+  // Takes the object's learnt down (and its run of contradictions) from another predictor of the
+  // same scene: a restart on a corrected clock keeps what the scene's gravity is.
+  void carry_learnt_gravity(const Predictor& from) { gravity_ = from.gravity_; }
 
   // The newest filter state (ImuAided), for diagnostics and tests; empty before initialisation.
   std::optional<NavState> state() const;
@@ -118,6 +140,8 @@ class Predictor {
   double last_jump_t_s_ = 0;  // time of the newest of them
   bool initialised_ = false;
   bool reinit_pending_ = false;
+  int applied_in_a_row_ = 0;
+  LearntGravity gravity_;
   PredictorStatus status_;
 };
 

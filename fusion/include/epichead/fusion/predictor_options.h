@@ -5,6 +5,7 @@
 
 #include "epichead/fusion/constant_velocity.h"
 #include "epichead/fusion/imu_propagation.h"
+#include "epichead/fusion/learnt_gravity.h"
 
 namespace epichead::fusion {
 
@@ -42,6 +43,7 @@ struct PredictorOptions {
   double initial_gyro_bias_radps = 0.02;
   double initial_accel_bias_mps2 = 0.2;
   ConstantVelocityNoise cv_noise;       // Mode::ConstantVelocity
+  GravityCheckOptions gravity_check;    // Mode::ImuAided: poses checked against the learnt down
 };
 
 }  // namespace epichead::fusion

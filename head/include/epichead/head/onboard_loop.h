@@ -93,6 +93,10 @@ struct TrackedFrame {
   const vision::FrameReport* report = nullptr;
   const vision::ModelTracker* tracker = nullptr;
   const hw::CameraFrame* image = nullptr;
+  // The frame's status as the loop took it: the tracker's, or Lost when its pose tilted the
+  // object away from the down the accelerometer measures (a wrong lock, fusion/learnt_gravity.h).
+  vision::TrackStatus status = vision::TrackStatus::Lost;
+  bool against_gravity = false;
 };
 using FrameHook = std::function<void(const TrackedFrame&)>;
 
@@ -132,6 +136,7 @@ struct OnboardSummary {
   // Acquisition (set_detector): detections run and how many found the object; losses (runs of
   // lost results) and re-acquisitions by detection; when detection first found the object.
   std::uint64_t detections = 0, detections_found = 0, losses = 0, reacquisitions = 0;
+  std::uint64_t against_gravity = 0;  // poses (tracked or detected) refused as wrong locks: their tilt
   double first_detection_t_s = -1;
   double detect_ms_max = 0;
 };

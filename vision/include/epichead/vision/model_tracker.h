@@ -47,6 +47,8 @@ enum class TrackReason : std::uint32_t {
   HighResidual = 1u << 4,    // robust residual scale above max_scale_px
   Jump = 1u << 5,            // the pose moved implausibly far from the prediction
   Reacquired = 1u << 6,      // tracked again after a loss (informational)
+  AgainstGravity = 1u << 7,  // set by the caller with an IMU: the pose tilts the object away from
+                             // the down the accelerometer measures (a wrong lock; fusion/learnt_gravity.h)
 };
 constexpr TrackReason operator|(TrackReason a, TrackReason b) {
   return static_cast<TrackReason>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));

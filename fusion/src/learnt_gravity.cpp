@@ -1,0 +1,80 @@
+#include "epichead/fusion/learnt_gravity.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "epichead/fusion/nav_state.h"
+#include "epichead/geometry/so3.h"
+
+namespace epichead::fusion {
+
+void LearntGravity::learn(double t_s, const Eigen::Vector3d& down_obj, double sigma_rad,
+                          const Eigen::Vector3d& gyro_bias_radps, const Eigen::Vector3d& accel_bias_mps2,
+                          int applied_in_a_row) {
+  if (!options_.enabled || applied_in_a_row < options_.learn_after_applied || !(sigma_rad < options_.learn_sigma_rad) ||
+      !down_obj.allFinite() || down_obj.norm() < 1e-9)
+    return;
+  const Eigen::Vector3d d = down_obj.normalized();
+  if (!learnt_) {
+    down_obj_ = d;
+  } else {
+    const double a = std::clamp((t_s - learnt_t_s_) / options_.learn_time_s, 0.0, 1.0);
+    down_obj_ = ((1 - a) * down_obj_ + a * d).normalized();
+  }
+  gyro_bias_radps_ = gyro_bias_radps;
+  accel_bias_mps2_ = accel_bias_mps2;
+  learnt_ = true;
+  learnt_t_s_ = t_s;
+}
+
+std::optional<double> LearntGravity::tilt_error_rad(const Eigen::Matrix3d& cam_R_obj,
+                                                    const std::optional<Eigen::Vector3d>& down_cam) const {
+  if (!options_.enabled || !learnt_ || !down_cam) return std::nullopt;
+  const Eigen::Vector3d pose_down = cam_R_obj * down_obj_;
+  return std::atan2(pose_down.cross(*down_cam).norm(), pose_down.dot(*down_cam));
+}
+
+void LearntGravity::note_verdict(double t_s, bool contradicts) {
+  if (!contradicts) {
+    contradicted_since_s_ = -1;
+    return;
+  }
+  if (contradicted_since_s_ < 0) contradicted_since_s_ = t_s;
+  if (t_s - contradicted_since_s_ >= options_.forget_after_s) {
+    learnt_ = false;
+    contradicted_since_s_ = -1;
+    ++forgotten_;
+  }
+}
+
+std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, double t_s, double window_s,
+                                                 double min_window_s, double dropout_gap_s,
+                                                 const Eigen::Vector3d& gyro_bias_radps,
+                                                 const Eigen::Vector3d& accel_bias_mps2) {
+  const std::optional<std::uint64_t> k = history.find_at_or_before(t_s);
+  if (!k) return std::nullopt;
+  const double newest_t = history.at(*k).sample.t_s;
+  if (t_s - newest_t > dropout_gap_s) return std::nullopt;  // the exposure is inside a gap
+  // imu_R: the IMU frame at the newest sample <- the IMU frame at the sample being added. From a
+  // sample to the next the body turns by exp(w dt), so a reading is brought forward by its transpose.
+  Eigen::Matrix3d imu_R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d sum = history.at(*k).sample.accel_mps2 - accel_bias_mps2;
+  double oldest_t = newest_t;
+  int n = 1;
+  for (std::uint64_t seq = *k; seq > history.oldest_seq(); --seq) {
+    const ImuSample& later = history.at(seq).sample;
+    const ImuSample& s = history.at(seq - 1).sample;
+    const double dt = later.t_s - s.t_s;
+    if (dt > dropout_gap_s || newest_t - s.t_s > window_s) break;
+    imu_R = imu_R * geometry::so3_exp((s.gyro_radps - gyro_bias_radps) * dt).transpose();
+    sum += imu_R * (s.accel_mps2 - accel_bias_mps2);
+    oldest_t = s.t_s;
+    ++n;
+  }
+  if (newest_t - oldest_t < min_window_s) return std::nullopt;
+  const Eigen::Vector3d f = sum / n;
+  if (!f.allFinite() || std::abs(f.norm() - standard_gravity_mps2) > 0.3 * standard_gravity_mps2) return std::nullopt;
+  return (-f).normalized();
+}
+
+}  // namespace epichead::fusion

@@ -1,0 +1,186 @@
+// The object's down learnt while vision and the IMU agree, and the check of a pose's tilt against
+// the accelerometer (fusion/learnt_gravity.h): a pose tilted off is a wrong lock, a turn about
+// gravity cannot be seen, a re-initialisation from a tilted pose is refused, and a long run of
+// contradictions forgets the learnt down (the object was moved).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "epichead/fusion/learnt_gravity.h"
+#include "epichead/fusion/predictor.h"
+#include "epichead/geometry/so3.h"
+#include "truth_helpers.h"
+
+using namespace epichead::fusion;
+using namespace epichead::fusion::testing;
+namespace geometry = epichead::geometry;
+
+namespace {
+
+constexpr double deg = M_PI / 180;
+
+double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+// The truth's pose turned by `angle_rad` about `axis_cam` (camera frame).
+Eigen::Isometry3d turned(const Eigen::Isometry3d& cam_T_obj, const Eigen::Vector3d& axis_cam, double angle_rad) {
+  Eigen::Isometry3d out = cam_T_obj;
+  out.linear() = Eigen::AngleAxisd(angle_rad, axis_cam.normalized()).toRotationMatrix() * cam_T_obj.linear();
+  return out;
+}
+
+// The sinusoidal truth tracked for `seconds` with exact 30 Hz poses: long enough to learn.
+struct Tracked {
+  Trajectory traj;
+  ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 12.0, 5);
+  Predictor predictor;
+  std::size_t next = 0;
+  double t_s = 0.2;
+
+  explicit Tracked(double seconds, const PredictorOptions& options = {}) : predictor(*Predictor::create(options)) {
+    feed_until(t_s);
+    REQUIRE(predictor.add_vision(t_s, traj.at(t_s).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
+    run_to(0.2 + seconds);
+  }
+  void feed_until(double t) {
+    for (; next < imu.samples.size() && imu.samples[next].t_s <= t + 1e-9; ++next) predictor.add_imu(imu.samples[next]);
+  }
+  void run_to(double end_s) {
+    while (t_s + 1.0 / 30 <= end_s) {
+      t_s += 1.0 / 30;
+      feed_until(t_s + 0.001);
+      REQUIRE(predictor.add_vision(t_s, traj.at(t_s).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Applied);
+    }
+  }
+  Eigen::Vector3d true_down_obj() const { return traj.params().gravity_dir_obj.normalized(); }  // gravity's direction
+};
+
+}  // namespace
+
+TEST_CASE("the accelerometer's down, brought forward by the gyro over the window, is the true down while the camera turns") {
+  const Trajectory traj;
+  const ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 2.0, 1);
+  StateHistory history(2100);
+  for (const ImuSample& s : imu.samples) history.push(s, false);
+  for (double t : {0.6, 1.0, 1.7}) {
+    INFO("t " << t);
+    const auto down = measured_down_imu(history, t, 0.4, 0.15, 0.0035, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    REQUIRE(down);
+    // The truth: gravity (down) in the camera frame (the IMU's here). The trajectory accelerates a
+    // little on average over 0.4 s, which is what is left.
+    const TruthPoint p = traj.at(t);
+    const Eigen::Vector3d truth = p.x.obj_R_cam.transpose() * p.x.gravity_obj_mps2().normalized();
+    CHECK(angle_between(*down, truth) < 2.0 * deg);
+    // Without the gyro's turn (a window of one sample's worth of turning) it would be worse:
+    // the readings' plain mean is off by the turn inside the window.
+    Eigen::Vector3d plain = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (const ImuSample& s : imu.samples)
+      if (s.t_s > t - 0.4 && s.t_s <= t) plain += s.accel_mps2, ++n;
+    CHECK(angle_between(-plain / n, truth) > angle_between(*down, truth));
+  }
+}
+
+TEST_CASE("no measured down inside a dropout, across one, or from too short a window") {
+  const Trajectory traj;
+  const ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 2.0, 1);
+  StateHistory history(2000);
+  for (const ImuSample& s : imu.samples)
+    if (s.t_s < 1.0 || s.t_s > 1.3) history.push(s, false);  // a 0.3 s gap
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  CHECK(measured_down_imu(history, 0.9, 0.4, 0.15, 0.0035, zero, zero));
+  CHECK_FALSE(measured_down_imu(history, 1.2, 0.4, 0.15, 0.0035, zero, zero));   // inside the gap
+  CHECK_FALSE(measured_down_imu(history, 1.35, 0.4, 0.15, 0.0035, zero, zero));  // 0.05 s since it
+  CHECK(measured_down_imu(history, 1.5, 0.4, 0.15, 0.0035, zero, zero));
+  CHECK_FALSE(measured_down_imu(history, 0.1, 0.4, 0.15, 0.0035, zero, zero));   // 0.1 s of samples
+}
+
+TEST_CASE("the down is learnt after a second of agreeing poses, and a pose tilted 15 deg is a wrong lock while one turned about gravity is not") {
+  Tracked run(0.5);
+  // Half a second: not yet learnt (30 applied poses in a row are needed).
+  CHECK_FALSE(run.predictor.learnt_down_obj());
+  CHECK_FALSE(run.predictor.check_tilt(run.t_s, run.traj.at(run.t_s).x.cam_T_obj()));
+  run.run_to(2.0);
+  const auto down = run.predictor.learnt_down_obj();
+  REQUIRE(down);
+  CHECK(angle_between(*down, run.true_down_obj()) < 1.0 * deg);
+  CHECK(run.predictor.status(run.t_s).gravity_learnt);
+
+  const double t = run.t_s;
+  const Eigen::Isometry3d truth = run.traj.at(t).x.cam_T_obj();
+  const Eigen::Vector3d down_cam = truth.linear() * run.true_down_obj();
+  const auto right = run.predictor.tilt_error_rad(t, truth);
+  REQUIRE(right);
+  CHECK(*right < 2.0 * deg);
+  CHECK_FALSE(run.predictor.check_tilt(t, truth));
+  // Tilted about an axis across gravity: seen.
+  const Eigen::Vector3d across = down_cam.unitOrthogonal();
+  CHECK(run.predictor.check_tilt(t, turned(truth, across, 15 * deg)));
+  CHECK(run.predictor.status(t).counters.vision_against_gravity == 1);
+  // A few degrees: within the measurement's noise, not a contradiction.
+  CHECK_FALSE(run.predictor.check_tilt(t, turned(truth, across, 4 * deg)));
+  // Turned about gravity itself: the accelerometer cannot tell.
+  CHECK_FALSE(run.predictor.check_tilt(t, turned(truth, down_cam, 30 * deg)));
+}
+
+TEST_CASE("after a reset the predictor refuses to start again from a tilted pose and starts from an upright one") {
+  Tracked run(2.0);
+  REQUIRE(run.predictor.learnt_down_obj());
+  run.predictor.reset();
+  const double t = run.t_s + 1.0 / 30;
+  run.feed_until(t + 0.001);
+  const Eigen::Isometry3d truth = run.traj.at(t).x.cam_T_obj();
+  const Eigen::Vector3d across = (truth.linear() * run.true_down_obj()).unitOrthogonal();
+  CHECK(run.predictor.add_vision(t, turned(truth, across, 20 * deg), pose_cov(1e-3, 1e-3)).verdict ==
+        VisionVerdict::AgainstGravity);
+  CHECK_FALSE(run.predictor.status(t).initialised);
+  // The learnt down survives the reset.
+  CHECK(run.predictor.learnt_down_obj());
+  CHECK(run.predictor.add_vision(t, truth, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
+}
+
+TEST_CASE("contradictions for longer than forget_after_s forget the learnt down, an agreeing pose between restarts the count") {
+  PredictorOptions options;
+  options.gravity_check.forget_after_s = 1.0;
+  Tracked run(2.0, options);
+  REQUIRE(run.predictor.learnt_down_obj());
+  const auto tilted_at = [&](double t) {
+    const Eigen::Isometry3d truth = run.traj.at(t).x.cam_T_obj();
+    return turned(truth, (truth.linear() * run.true_down_obj()).unitOrthogonal(), 25 * deg);
+  };
+  double t = run.t_s;
+  for (int i = 0; i < 20; ++i) {  // 0.67 s of contradictions
+    t += 1.0 / 30;
+    run.feed_until(t + 0.001);
+    CHECK(run.predictor.check_tilt(t, tilted_at(t)));
+  }
+  t += 1.0 / 30;
+  run.feed_until(t + 0.001);
+  CHECK_FALSE(run.predictor.check_tilt(t, run.traj.at(t).x.cam_T_obj()));  // agrees: the run restarts
+  for (int i = 0; i < 20; ++i) {
+    t += 1.0 / 30;
+    run.feed_until(t + 0.001);
+    CHECK(run.predictor.check_tilt(t, tilted_at(t)));
+  }
+  CHECK(run.predictor.learnt_down_obj());
+  for (int i = 0; i < 15; ++i) {  // past 1 s in a row
+    t += 1.0 / 30;
+    run.feed_until(t + 0.001);
+    run.predictor.check_tilt(t, tilted_at(t));
+  }
+  CHECK_FALSE(run.predictor.learnt_down_obj());
+  CHECK(run.predictor.status(t).counters.gravity_forgotten == 1);
+  // Nothing learnt: nothing contradicts.
+  CHECK_FALSE(run.predictor.check_tilt(t, tilted_at(t)));
+}
+
+TEST_CASE("gravity_check options out of range are refused") {
+  PredictorOptions o;
+  o.gravity_check.min_window_s = 1.0;  // longer than window_s
+  CHECK_FALSE(Predictor::create(o));
+  o = PredictorOptions{};
+  o.gravity_check.max_tilt_error_rad = 0;
+  CHECK_FALSE(Predictor::create(o));
+  o = PredictorOptions{};
+  o.gravity_check.learn_after_applied = 0;
+  CHECK_FALSE(Predictor::create(o));
+}
