@@ -197,23 +197,60 @@ TEST_CASE("sim-run: a 2 mrad backlash the controller is not told of is estimated
 
 // The soak's drift (docs/head.md section 6), in ten seconds: a bus-off 0.1 s into a walking
 // step's burst silences the IMU (it is on the same bus) while the head, without commands, lets
-// the camera swing with the body; the tracker settles on a pose tens of degrees off that it keeps
-// reporting as tracked, and the predictor, its poses gated and then re-initialised from the
-// tracker's, follows it for good. OPEN (issue 22): this reproduces it and fails while the drift is
-// there; [!shouldfail] keeps the suite green until it is fixed, and must then be taken off.
-TEST_CASE("sim-run --soak: after a bus-off inside a step's burst the tracker and the prediction come back to the truth",
-          "[tools][sim-run][soak][!shouldfail]") {
-  TempDir dir("sim_run_bus_off_drift");
+// the camera swing with the body; the tracker settles on a pose 18-30 deg off, almost all of it a
+// tilt. The accelerometer's down against the object's learnt down (fusion/learnt_gravity.h)
+// refuses it: the frames count as lost instead of tracked 20 deg off, and the loop keeps its safe
+// modes. Before the check, 100 frames after the bus-off were tracked 15-31 deg off.
+namespace {
+
+struct BusOffRun {
+  nlohmann::json summary;
+  int tracked_off_10deg_after_fault = 0;  // frames tracked with the tracker's pose > 10 deg off
+};
+
+BusOffRun run_bus_off(TempDir& dir) {
   const std::string scn = dir.write("bus_off.scn", slurp(std::string(EPICHEAD_SOURCE_DIR) + "/sim/scenarios/mockup_walk.scn") +
                                                        "fault bus_off 6.0 0.3\n");
   const auto r = run_epichead(dir, "sim-run '" + scn + "' --out '" + dir.str() +
                                        "/out' --seconds 10 --soak --soak-warmup-s 1 --downscale 2 --every 0");
   INFO(r.out << r.err);
   REQUIRE(r.exit_code == 0);
-  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
-  INFO(j["soak"].dump());
-  // Measured (seed 1): 2.6 deg early, 81 deg over the last second; the tracker's own error the same.
-  CHECK(j["soak"]["predicted_attitude_error_deg_median_late"].get<double>() < 3.0);
+  BusOffRun run;
+  run.summary = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  const auto rows = lines_of(slurp(dir / "out/attitude_error.csv"));
+  REQUIRE(rows.size() > 200);
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    double t = 0, predicted = 0, tracked = 0;
+    if (std::sscanf(rows[i].c_str(), "%lf,%lf,%lf", &t, &predicted, &tracked) == 3 && t > 6.0 && tracked > 10.0)
+      ++run.tracked_off_10deg_after_fault;
+  }
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("sim-run --soak: after a bus-off inside a step's burst the tilted lock is refused, not tracked", "[tools][sim-run][soak]") {
+  TempDir dir("sim_run_bus_off_refused");
+  const BusOffRun run = run_bus_off(dir);
+  INFO(run.summary.dump());
+  CHECK(run.summary["loop"]["deadlines"]["acquisition"]["against_gravity"].get<int>() >= 20);
+  // Measured: 7 (the first frame after the gap, before 0.15 s of accelerometer is back, and a
+  // lock 15 deg off that is wrong about gravity's axis, which the accelerometer cannot see).
+  CHECK(run.tracked_off_10deg_after_fault <= 10);
+}
+
+// OPEN (issue 22): coming back. After the refusal the predictor keeps the attitude it coasted to
+// through the gap (5 deg off, then 23 deg after a lock wrong about gravity's axis), the tracker
+// cannot lock from it, and no detector runs at --downscale 2; at full size with --reacquire the
+// detector does not find the mockup, half out of the view after the head's hold. [!shouldfail]
+// keeps the suite green until it is fixed, and must then be taken off.
+TEST_CASE("sim-run --soak: after a bus-off inside a step's burst the tracker and the prediction come back to the truth",
+          "[tools][sim-run][soak][!shouldfail]") {
+  TempDir dir("sim_run_bus_off_drift");
+  const BusOffRun run = run_bus_off(dir);
+  INFO(run.summary["soak"].dump());
+  // Measured (seed 1): 1.3 deg early, 23 deg over the last second.
+  CHECK(run.summary["soak"]["predicted_attitude_error_deg_median_late"].get<double>() < 3.0);
 }
 
 TEST_CASE("sim-run leaves the frames a cover board hides the object in out of the tracking success, as score does",
