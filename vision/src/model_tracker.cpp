@@ -120,6 +120,8 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   const std::size_t slots = edges + model.vertices.size() + model.circles.size();
   estimator_.reserve(slots, observations);
   pose_.residuals.reserve(slots);
+  // The first frame is a start: its outline colours must not wait on the allocator.
+  if (options.outline_colours) region_.reserve(camera.width_px(), camera.height_px());
 }
 
 void ModelTracker::reset() {
