@@ -120,7 +120,9 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   const std::size_t slots = edges + model.vertices.size() + model.circles.size();
   estimator_.reserve(slots, observations);
   pose_.residuals.reserve(slots);
-  // The first frame is a start: its outline colours must not wait on the allocator.
+  // The first frame is a start: its windows and its outline colours must not wait on the
+  // allocator or on page faults.
+  lines_.reserve(static_cast<int>(edges));
   if (options.outline_colours) region_.reserve(camera.width_px(), camera.height_px());
 }
 
