@@ -3,7 +3,11 @@
 // it (issue 19: a can's bottom rim and the lower border of its label).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -124,4 +128,163 @@ TEST_CASE("from a start between a printed border and the rim, outline colours pu
     if (weigh) CHECK(found == Approx(rim).margin(1.5));
     else CHECK(found == Approx(label).margin(1.5));  // the case the colours are for
   }
+}
+
+namespace {
+
+// The object region as first written, with OpenCV's distance transforms over the whole box and a
+// frame-sized mask drawn afresh: what ObjectRegion must reproduce exactly, with less work.
+struct ReferenceRegion {
+  cv::Mat mask;
+  std::array<float, 512> p_object{};
+  bool ready = false;
+};
+
+ReferenceRegion reference_region(const WindowImage& image, const CadModel& model, const Camera& camera,
+                                 const Eigen::Isometry3d& cam_T_obj, const ObjectRegionOptions& o = {}) {
+  ReferenceRegion r;
+  const int w = image.width_px(), h = image.height_px();
+  r.mask = cv::Mat::zeros(h, w, CV_8U);
+  int x0 = w, y0 = h, x1 = -1, y1 = -1;
+  const auto fill = [&](const std::vector<Eigen::Vector3d>& points_obj) {
+    std::vector<cv::Point> polygon, hull;
+    for (const Eigen::Vector3d& p_obj : points_obj) {
+      const Eigen::Vector3d p = cam_T_obj * p_obj;
+      if (!(p.z() > 0.01)) return;
+      const Eigen::Vector2d px = camera.project(p);
+      polygon.emplace_back(static_cast<int>(std::lround(px.x())), static_cast<int>(std::lround(px.y())));
+    }
+    cv::convexHull(polygon, hull);
+    cv::fillConvexPoly(r.mask, hull, cv::Scalar(255));
+    for (const cv::Point& q : hull) {
+      x0 = std::min(x0, q.x);
+      y0 = std::min(y0, q.y);
+      x1 = std::max(x1, q.x);
+      y1 = std::max(y1, q.y);
+    }
+  };
+  const auto circle = [](const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius, int i) {
+    const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.normalized().cross(u);
+    const double a = 2 * M_PI * i / 32;
+    return Eigen::Vector3d(centre + radius * (std::cos(a) * u + std::sin(a) * v));
+  };
+  for (const ModelFace& face : model.faces)
+    for (const auto& t : face.triangles)
+      fill({model.vertices[static_cast<std::size_t>(t[0])], model.vertices[static_cast<std::size_t>(t[1])], model.vertices[static_cast<std::size_t>(t[2])]});
+  for (const ModelCircle& c : model.circles) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 32; ++i) points.push_back(circle(c.centre_obj, c.normal_obj, c.radius_m, i));
+    fill(points);
+  }
+  for (const ModelCylinder& c : model.cylinders) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 64; ++i) points.push_back(circle(i < 32 ? c.axis_a_obj : c.axis_b_obj, c.axis_b_obj - c.axis_a_obj, c.radius_m, i % 32));
+    fill(points);
+  }
+  const int pad = static_cast<int>(std::ceil(o.outer_margin_px + o.ring_px)) + 2;
+  x0 = std::max(x0 - pad, 0);
+  y0 = std::max(y0 - pad, 0);
+  x1 = std::min(x1 + pad, w - 1);
+  y1 = std::min(y1 + pad, h - 1);
+  if (x1 < x0 || y1 < y0) return r;
+  const cv::Rect box(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  cv::Mat inside, outside, not_mask;
+  cv::distanceTransform(r.mask(box), inside, cv::DIST_L2, cv::DIST_MASK_3);
+  cv::bitwise_not(r.mask(box), not_mask);
+  cv::distanceTransform(not_mask, outside, cv::DIST_L2, cv::DIST_MASK_3);
+  std::array<float, 512> object{}, background{};
+  float n_object = 0, n_background = 0;
+  const auto bin = [](float v) { return std::clamp(static_cast<int>(v * (8 / 256.0f)), 0, 7); };
+  for (int y = 0; y < box.height; y += 2)
+    for (int x = 0; x < box.width; x += 2) {
+      const float* p = image.pixels() + (static_cast<std::size_t>(y + y0) * w + (x + x0)) * kCueChannels;
+      const int b = (bin(p[0]) * 8 + bin(p[1])) * 8 + bin(p[2]);
+      const float din = inside.at<float>(y, x), dout = outside.at<float>(y, x);
+      if (din > o.inner_margin_px) { object[b] += 1; n_object += 1; }
+      else if (dout > o.outer_margin_px && dout <= o.outer_margin_px + o.ring_px) { background[b] += 1; n_background += 1; }
+    }
+  if (n_object < o.min_samples || n_background < o.min_samples) return r;
+  for (std::size_t b = 0; b < 512; ++b) {
+    const float po = (object[b] + 1.0f / 512) / (n_object + 1), pb = (background[b] + 1.0f / 512) / (n_background + 1);
+    r.p_object[b] = po / (po + pb);
+  }
+  r.ready = true;
+  return r;
+}
+
+// A can: its cylinder and its two rims.
+CadModel can_model() {
+  CadModel m;
+  ModelCylinder body;
+  body.axis_b_obj = {0, 0, 0.12};
+  body.radius_m = 0.033;
+  m.cylinders.push_back(body);
+  for (const double z : {0.0, 0.12}) {
+    ModelCircle rim;
+    rim.centre_obj = {0, 0, z};
+    rim.radius_m = 0.033;
+    m.circles.push_back(rim);
+  }
+  return m;
+}
+
+// A box of triangles, 16 x 7 x 8 cm (the tea box's size).
+CadModel box_model() {
+  CadModel m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1 ? 0.165 : 0.0, i & 2 ? 0.068 : 0.0, i & 4 ? -0.08 : 0.0);
+  for (const auto& q : std::vector<std::array<int, 4>>{{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}}) {
+    ModelFace f;
+    f.vertices = {q[0], q[1], q[2], q[3]};
+    f.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
+    m.faces.push_back(f);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("the object region learns exactly what OpenCV's distance transforms over the whole box give", "[object_region]") {
+  // Random colours in small blocks, so that a single pixel classified differently changes a
+  // histogram; poses near, far, and across every border of the frame, one region reused for
+  // all of them (what the last start drew must not remain).
+  cv::Mat img(240, 320, CV_8UC3);
+  cv::randu(img, cv::Scalar::all(0), cv::Scalar::all(256));
+  cv::resize(img(cv::Rect(0, 0, 80, 60)), img, img.size(), 0, 0, cv::INTER_NEAREST);
+  WindowImage image;
+  REQUIRE(image.assign(img));
+  ObjectRegion region;
+  cv::RNG rng(24);
+  int learnt = 0, compared = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const CadModel model = trial % 2 ? box_model() : can_model();
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::AngleAxisd(rng.uniform(0.0, 2 * M_PI), Eigen::Vector3d(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)).normalized()).toRotationMatrix();
+    const double z = rng.uniform(0.25, 0.9);
+    pose.translation() = Eigen::Vector3d(rng.uniform(-0.6, 0.6) * z, rng.uniform(-0.45, 0.45) * z, z);
+    const ReferenceRegion expected = reference_region(image, model, kCamera, pose);
+    INFO("trial " << trial);
+    REQUIRE(region.learn(image, model, kCamera, pose) == expected.ready);
+    learnt += expected.ready;
+    if (!expected.ready) continue;
+    for (int b = 0; b < 512; ++b) {
+      IntervalCues cues;
+      cues.valid = true;
+      cues.value = {16.0f + 32 * (b / 64), 16.0f + 32 * (b / 8 % 8), 16.0f + 32 * (b % 8), 0};
+      if (region.object_probability(cues) != expected.p_object[static_cast<std::size_t>(b)]) FAIL("bin " << b);
+    }
+    for (int y = 0; y < 240; y += 3)
+      for (int x = 0; x < 320; x += 3) {
+        const Eigen::Vector2d at(x, y), dir(0.6, 0.8);
+        const auto inside = [&](const Eigen::Vector2d& p) {
+          const int px = static_cast<int>(std::lround(p.x())), py = static_cast<int>(std::lround(p.y()));
+          return px >= 0 && py >= 0 && px < 320 && py < 240 && expected.mask.at<std::uint8_t>(py, px) != 0;
+        };
+        const bool p = inside(at + 3 * dir), m = inside(at - 3 * dir);
+        const int side = p == m ? 0 : (p ? -1 : 1);
+        if (region.outer_side(at, dir) != side) FAIL("outer side at " << x << ", " << y);
+      }
+    ++compared;
+  }
+  CHECK(learnt >= 20);  // most poses see enough of the object and of its background
+  CHECK(compared == learnt);
 }

@@ -1,9 +1,12 @@
-// Benchmark object_region_can: ObjectRegion::learn on the can scenario's first frame at its
-// true pose (the model drawn, the distances to its outline in the drawn box, the two colour
-// histograms). It runs on the frames that settle (the first, after a loss, per detection
-// hypothesis), so what it adds to a detection is this times the hypotheses refined.
+// ObjectRegion::learn (the model drawn, the distances to its outline, the two colour
+// histograms) on a scenario's first frame at its true pose:
+//   object_region_can   the can (cylinder and rims), small in the frame
+//   object_region_box   box_clutter's printed package, 640x480: a box like the real tea box's
+// It runs on the frames that settle (the first, after a loss, per detection hypothesis), so
+// what it adds to a detection is this times the hypotheses refined.
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "bench/bench.h"
 #include "bench/simulated_sequence.h"
@@ -19,15 +22,18 @@ struct RegionBench {
   vision::ObjectRegion region;
 };
 
-const Registration object_region_can{"object_region_can", [] {
+Iteration learn_on(const std::string& scenario) {
   auto b = std::make_shared<RegionBench>();
-  b->sim = simulate_builtin("can", 1);
+  b->sim = simulate_builtin(scenario, 1);
   (void)b->image.assign(b->sim.frames.front());
   const Eigen::Isometry3d pose = b->sim.seq->ground_truth().front().cam_T_obj;
   if (!b->region.learn(b->image, b->sim.seq->model(), b->sim.seq->camera(), pose))
-    throw std::runtime_error("object_region_can: the can's region was not learnt");
+    throw std::runtime_error("object_region: the region of " + scenario + " was not learnt");
   return [b, pose] { b->region.learn(b->image, b->sim.seq->model(), b->sim.seq->camera(), pose); };
-}};
+}
+
+const Registration object_region_can{"object_region_can", [] { return learn_on("can"); }};
+const Registration object_region_box{"object_region_box", [] { return learn_on("box_clutter"); }};
 
 }  // namespace
 }  // namespace epichead::bench

@@ -12,8 +12,8 @@ namespace epichead::vision {
 void EdgelSet::reserve(const WindowOptions& options) {
   const int cols = std::clamp(options.width_px, 8, kMaxWindowWidth), rows = std::max(options.max_rows, 2);
   // Maxima are at least two columns apart (strict on one side), so cols / 2 per row at most.
-  edgels.reserve(static_cast<std::size_t>(rows) * (cols / 2 + 1));
-  row_begin.reserve(static_cast<std::size_t>(rows) + 1);
+  reserve_touched(edgels, static_cast<std::size_t>(rows) * (cols / 2 + 1));
+  reserve_touched(row_begin, static_cast<std::size_t>(rows) + 1);
   gradient.resize(static_cast<std::size_t>(rows) * cols);
 }
 

@@ -43,10 +43,10 @@ int side_interval(const EdgelSet& set, const std::vector<IntervalCues>& interval
 void EpicResult::reserve(const WindowOptions& window, const RansacOptions& ransac) {
   edgels.reserve(window);
   const std::size_t n = static_cast<std::size_t>(max_edgels(window));
-  intervals.reserve(n + static_cast<std::size_t>(std::max(window.max_rows, 2)));
-  good.reserve(n);
-  candidates.reserve(32);
-  inliers.reserve(n * static_cast<std::size_t>(std::max(ransac.max_candidates, 1)));
+  reserve_touched(intervals, n + static_cast<std::size_t>(std::max(window.max_rows, 2)));
+  reserve_touched(good, n);
+  reserve_touched(candidates, 32);
+  reserve_touched(inliers, n * static_cast<std::size_t>(std::max(ransac.max_candidates, 1)));
 }
 
 EpicDetector::EpicDetector(const EpicOptions& options, const WindowOptions& window)

@@ -21,6 +21,18 @@ void LineTracker::reset() {
   }
 }
 
+void LineTracker::reserve(int edges) {
+  if (edges > static_cast<int>(features_.size())) {
+    features_.resize(static_cast<std::size_t>(edges));
+    longest_.resize(features_.size());
+  }
+  for (LineFeature& f : features_) {
+    if (f.reserved) continue;
+    f.result.reserve(options_.window, options_.epic.ransac);
+    f.reserved = true;
+  }
+}
+
 void LineTracker::track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
   detect(image, visible, placement);
   for (LineFeature& f : features_) {

@@ -121,6 +121,10 @@ ModelTracker::ModelTracker(const CadModel& model, const Camera& camera, const Mo
   const std::size_t slots = edges + model.vertices.size() + model.circles.size();
   estimator_.reserve(slots, observations);
   pose_.residuals.reserve(slots);
+  // The first frame is a start: its windows and its outline colours must not wait on the
+  // allocator or on page faults.
+  lines_.reserve(static_cast<int>(edges));
+  if (options.outline_colours) region_.reserve(camera.width_px(), camera.height_px());
 }
 
 void ModelTracker::reset() {
@@ -296,7 +300,9 @@ void ModelTracker::set_mode(TrackMode mode) {
   ellipses_.set_mode(epic_mode(mode));
 }
 
-Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times) {
+Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times,
+                                       FrameReport& measured, bool& reused) {
+  reused = false;
   // How well the image supports a measurement: the share of found features the pose keeps.
   const auto support = [](const FrameReport& r) {
     return static_cast<double>(r.inliers + 2 * r.ellipses_found) / std::max(1, r.found + 2 * r.ellipses_found);
@@ -316,7 +322,16 @@ Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Is
   ellipses_.reset();
   const bool refined_ok = measure(image, gradient.cam_T_obj, refined);
   times.add_stages(refined.times);
-  if (refined_ok && (!direct_ok || support(refined) >= support(direct))) return gradient.cam_T_obj;
+  if (refined_ok && (!direct_ok || support(refined) >= support(direct))) {
+    // The tracker's state (features, validation, pose) is still that of the refined measurement,
+    // and a line's measurement depends only on the image, the pose and its references. Not so
+    // an ellipse's: its tracker lines are placed on the arc its last measurement found.
+    if (refined.ellipses_visible > 0) return gradient.cam_T_obj;
+    measured = refined;
+    measured.times = StageTimes{};  // already in `times`
+    reused = true;
+    return gradient.cam_T_obj;
+  }
   lines_.reset();
   ellipses_.reset();
   return predicted;
@@ -343,8 +358,9 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
     }
     settling.epic_ms += ms_since(t);
   }
-  const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling);
-  bool pose_ok = measure(image, start, out);
+  bool reused = false;
+  const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling, out, reused);
+  bool pose_ok = reused || measure(image, start, out);
   out.times.add_stages(settling);
   if (!pose_ok && fallback) {
     // The second opinion: measured afresh from the other prediction (measure() learns nothing,

@@ -25,6 +25,16 @@ struct Edgel {
   int left_interval = 0;  // index of the interval on its left (lower columns); right is +1
 };
 
+// Reserves n elements of v and writes them once, so that the pages are mapped now, at set-up,
+// and not on the first frame that fills them (a page fault costs microseconds).
+template <typename T>
+void reserve_touched(std::vector<T>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  v.reserve(n);
+  v.resize(n);
+  v.clear();
+}
+
 // All edgels of a window, row by row, in contiguous storage reserved once.
 struct EdgelSet {
   std::vector<Edgel> edgels;   // ordered by row, then by column

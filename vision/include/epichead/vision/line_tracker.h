@@ -1,7 +1,7 @@
 #pragma once
 // Per-frame line tracking: one EPIC window per visible model edge, per-feature cue references
 // kept across frames, and the selected line of each feature. Allocation-free after warm-up
-// (each feature's buffers are reserved the first time it is seen).
+// (each feature's buffers are reserved the first time it is seen, or all at once by reserve()).
 //
 // Two ways to use it: track() detects and takes each window's best candidate at once (line
 // tracking on its own); detect() followed by accept()/reject() per feature lets a later step
@@ -89,6 +89,9 @@ class LineTracker {
   const WindowOptions& window_options() const { return options_.window; }
   // Forgets all references and previous results.
   void reset();
+  // Sizes the buffers of the features of `edges` model edges now (set-up), instead of the
+  // first time each is seen (the first frame).
+  void reserve(int edges);
 
  private:
   void detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, bool look_through,

@@ -170,8 +170,12 @@ class ModelTracker {
   // and EPIC then prefers the wrong edges (lampshade, seed 13: 7 deg off for 55 frames). A
   // gradient pass, which needs no references, pulls the pose onto the strongest edges; EPIC
   // measures from both starts and the one whose pose keeps the larger share of its features
-  // is returned, with the references of that start.
-  Eigen::Isometry3d settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times);
+  // is returned, with the references of that start. When that start is the gradient pass's and
+  // no ellipse is seen, its EPIC measurement was settle()'s last and is left in `measured`
+  // (reused set): measuring again from the same start with the same references would repeat it
+  // exactly, a quarter of a start's cost.
+  Eigen::Isometry3d settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times,
+                           FrameReport& measured, bool& reused);
   void set_mode(TrackMode mode);
   const CadModel* model_;
   Camera camera_;

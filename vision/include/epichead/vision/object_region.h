@@ -25,6 +25,7 @@
 namespace epichead::vision {
 
 struct ObjectRegionOptions {
+  // The margins below are distances, not negative.
   // The object's colours are sampled deeper inside the drawn outline than this. Small: the
   // bands along the outline (a can's foot and lid ring) are the colours that matter most there;
   // the strip of background a start error draws inside only blurs the histogram a little.
@@ -45,10 +46,15 @@ class ObjectRegion {
  public:
   explicit ObjectRegion(const ObjectRegionOptions& options = {});
 
+  // Sizes the buffers for frames of this size and touches their pages, so that the first
+  // learn() neither allocates nor page-faults (that was 5 of the first frame's 6 ms on the real
+  // tea box video). Optional: learn() sizes them itself for a frame of another size.
+  void reserve(int width_px, int height_px);
+
   // Draws the model at cam_T_obj (faces, rims, cylinders) and learns the colours of the frame
-  // inside and around it. Returns ready(). Half a millisecond for the can at 640x480 (`epichead
-  // bench object_region_can`); it allocates (OpenCV's drawing and distance transforms), which
-  // is why it runs only on the frames that settle, never in steady tracking.
+  // inside and around it. Returns ready(). It runs on the frames that settle, never in steady
+  // tracking (`epichead bench object_region` for its cost). After reserve() for the frame's size
+  // it allocates nothing but what OpenCV's convex hull and polygon fill may.
   bool learn(const WindowImage& image, const CadModel& model, const Camera& camera, const Eigen::Isometry3d& cam_T_obj);
   void clear() { ready_ = false; }
   bool ready() const { return ready_; }
@@ -63,11 +69,23 @@ class ObjectRegion {
  private:
   static constexpr int kBins = 8;  // per channel: intensity, chromaticity r, chromaticity g
   static int bin(float v) { return std::clamp(static_cast<int>(v * (kBins / 256.0f)), 0, kBins - 1); }
+  using Histogram = std::array<int, kBins * kBins * kBins>;
+  // Draws the model into mask_ and returns the box of what was drawn, clipped to the frame
+  // (empty when nothing was).
+  cv::Rect draw(const CadModel& model, const Camera& camera, const Eigen::Isometry3d& cam_T_obj);
+  // Counts the colours of the pixels of the sampling grid (every second pixel of box, from its
+  // corner) whose distance to the drawn outline lies in (min_px, max_px]: inside the object, or
+  // outside it. Distances are computed over region, a part of box.
+  int count(const WindowImage& image, const cv::Rect& box, const cv::Rect& region, bool inside, float min_px,
+            float max_px, Histogram& histogram);
+
   ObjectRegionOptions options_;
   bool ready_ = false;
-  cv::Mat mask_, not_mask_;                  // CV_8U: the drawn object and its complement
-  cv::Mat inside_px_, outside_px_;           // CV_32F: distance to the outline, inside and outside (drawn box)
+  cv::Mat mask_;                             // CV_8U, the frame's size: the drawn object (255)
+  cv::Rect dirty_;                           // where mask_ may be non-zero
+  std::vector<std::int32_t> distance_;       // chamfer distances of one region, with a border
   std::vector<cv::Point> polygon_, hull_;    // scratch for drawing
+  Histogram object_{}, background_{};
   std::array<float, kBins * kBins * kBins> p_object_{};
 };
 
