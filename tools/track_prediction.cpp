@@ -1,5 +1,6 @@
 #include "track_prediction.h"
 
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -7,6 +8,7 @@
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
 #include "epichead/vision/pose_estimator.h"
+#include "epichead/vision/revolution_axis.h"
 
 namespace epichead::tools {
 namespace {
@@ -350,6 +352,8 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     options.reinit_after_gated = 15;
     // Until the offset is estimated, every pose's time on the IMU clock is that uncertain.
     if (!imu_time_offset_s) options.imu_time_offset_sigma_s = kUnknownOffsetSigmaS;
+    // A body of revolution's poses turn freely about its axis: only the axis's tilt is checked.
+    if (const auto axis = vision::find_revolution_axis(seq.model())) options.gravity_check.free_turn_axis_obj = axis->direction_obj.normalized();
     auto predictor = fusion::Predictor::create(options);
     if (!predictor) return std::unexpected("--imu on: " + predictor.error());
     std::optional<fusion::TimeOffsetEstimator> estimator;

@@ -30,8 +30,12 @@ void LearntGravity::learn(double t_s, const Eigen::Vector3d& down_obj, double si
 std::optional<double> LearntGravity::tilt_error_rad(const Eigen::Matrix3d& cam_R_obj,
                                                     const std::optional<Eigen::Vector3d>& down_cam) const {
   if (!options_.enabled || !learnt_ || !down_cam) return std::nullopt;
-  const Eigen::Vector3d pose_down = cam_R_obj * down_obj_;
-  return std::atan2(pose_down.cross(*down_cam).norm(), pose_down.dot(*down_cam));
+  const auto angle = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); };
+  if (const auto& axis = options_.free_turn_axis_obj) {
+    // The smallest tilt error over every turn about the axis.
+    return std::abs(angle(cam_R_obj * *axis, *down_cam) - angle(*axis, down_obj_));
+  }
+  return angle(cam_R_obj * down_obj_, *down_cam);
 }
 
 void LearntGravity::note_verdict(double t_s, bool contradicts) {
@@ -47,10 +51,9 @@ void LearntGravity::note_verdict(double t_s, bool contradicts) {
   }
 }
 
-std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, double t_s, double window_s,
-                                                 double min_window_s, double dropout_gap_s,
-                                                 const Eigen::Vector3d& gyro_bias_radps,
-                                                 const Eigen::Vector3d& accel_bias_mps2) {
+std::optional<MeanForce> mean_specific_force(const StateHistory& history, double t_s, double window_s, double min_window_s,
+                                            double dropout_gap_s, const Eigen::Vector3d& gyro_bias_radps,
+                                            const Eigen::Vector3d& accel_bias_mps2) {
   const std::optional<std::uint64_t> k = history.find_at_or_before(t_s);
   if (!k) return std::nullopt;
   const double newest_t = history.at(*k).sample.t_s;
@@ -59,8 +62,8 @@ std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, do
   // sample to the next the body turns by exp(w dt), so a reading is brought forward by its transpose.
   Eigen::Matrix3d imu_R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d sum = history.at(*k).sample.accel_mps2 - accel_bias_mps2;
-  double oldest_t = newest_t;
-  int n = 1;
+  MeanForce out;
+  out.newest_seq = out.oldest_seq = *k;
   for (std::uint64_t seq = *k; seq > history.oldest_seq(); --seq) {
     const ImuSample& later = history.at(seq).sample;
     const ImuSample& s = history.at(seq - 1).sample;
@@ -68,13 +71,28 @@ std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, do
     if (dt > dropout_gap_s || newest_t - s.t_s > window_s) break;
     imu_R = imu_R * geometry::so3_exp((s.gyro_radps - gyro_bias_radps) * dt).transpose();
     sum += imu_R * (s.accel_mps2 - accel_bias_mps2);
-    oldest_t = s.t_s;
-    ++n;
+    out.oldest_seq = seq - 1;
   }
-  if (newest_t - oldest_t < min_window_s) return std::nullopt;
-  const Eigen::Vector3d f = sum / n;
-  if (!f.allFinite() || std::abs(f.norm() - standard_gravity_mps2) > 0.3 * standard_gravity_mps2) return std::nullopt;
-  return (-f).normalized();
+  if (newest_t - history.at(out.oldest_seq).sample.t_s < min_window_s) return std::nullopt;
+  out.mean_imu_mps2 = sum / static_cast<double>(out.newest_seq - out.oldest_seq + 1);
+  if (!out.mean_imu_mps2.allFinite()) return std::nullopt;
+  return out;
+}
+
+std::optional<Eigen::Vector3d> down_from(const MeanForce& force, const Eigen::Vector3d& mean_accel_imu_mps2) {
+  // Specific force = acceleration - gravity: gravity = mean acceleration - mean force.
+  const Eigen::Vector3d g = mean_accel_imu_mps2 - force.mean_imu_mps2;
+  if (!g.allFinite() || std::abs(g.norm() - standard_gravity_mps2) > 0.3 * standard_gravity_mps2) return std::nullopt;
+  return g.normalized();
+}
+
+std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, double t_s, double window_s,
+                                                 double min_window_s, double dropout_gap_s,
+                                                 const Eigen::Vector3d& gyro_bias_radps,
+                                                 const Eigen::Vector3d& accel_bias_mps2) {
+  const auto force = mean_specific_force(history, t_s, window_s, min_window_s, dropout_gap_s, gyro_bias_radps, accel_bias_mps2);
+  if (!force) return std::nullopt;
+  return down_from(*force);
 }
 
 }  // namespace epichead::fusion

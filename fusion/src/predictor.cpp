@@ -237,8 +237,20 @@ std::optional<Eigen::Vector3d> Predictor::measured_down_cam(double t_s) const {
     ba = e->x.accel_bias_mps2;
   }
   const GravityCheckOptions& o = options_.gravity_check;
-  const std::optional<Eigen::Vector3d> down_imu =
-      measured_down_imu(imu_.history(), t_s, o.window_s, o.min_window_s, options_.dropout_gap_s, bg, ba);
+  const StateHistory& h = imu_.history();
+  const std::optional<MeanForce> force = mean_specific_force(h, t_s, o.window_s, o.min_window_s, options_.dropout_gap_s, bg, ba);
+  if (!force) return std::nullopt;
+  // A walking or hand-held camera accelerates on average over the window by up to a few m/s^2
+  // (up to 13 deg of tilt on the can scene); the filter's velocity at both ends of the window
+  // says by how much, when both carry a state.
+  Eigen::Vector3d accel_imu = Eigen::Vector3d::Zero();
+  if (force->oldest_seq >= h.first_state_seq()) {
+    const StateEntry& a = h.at(force->oldest_seq);
+    const StateEntry& b = h.at(force->newest_seq);
+    const double dt = b.sample.t_s - a.sample.t_s;
+    if (dt > 0) accel_imu = options_.mount.cam_R_imu.transpose() * b.x.obj_R_cam.transpose() * (b.x.obj_v_cam - a.x.obj_v_cam) / dt;
+  }
+  const std::optional<Eigen::Vector3d> down_imu = down_from(*force, accel_imu);
   if (!down_imu) return std::nullopt;
   return options_.mount.cam_R_imu * *down_imu;
 }

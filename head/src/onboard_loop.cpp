@@ -1,5 +1,6 @@
 #include "epichead/head/onboard_loop.h"
 
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -13,6 +14,7 @@
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
 #include "epichead/vision/pose_estimator.h"
+#include "epichead/vision/revolution_axis.h"
 #include "realtime.h"
 #include "recent_samples.h"
 #include "recorder.h"
@@ -374,6 +376,8 @@ std::expected<std::unique_ptr<OnboardLoop>, std::string> OnboardLoop::create(con
     return std::unexpected("onboard loop: control_rate_hz, time_sync_period_s and diagnostics_period_s must be > 0");
   fusion::PredictorOptions p = options.predictor;
   p.imu_time_offset_s = 0;  // samples arrive on the controller clock (time sync)
+  // A body of revolution's poses turn freely about its axis: only the axis's tilt is checked.
+  if (const auto axis = vision::find_revolution_axis(model)) p.gravity_check.free_turn_axis_obj = axis->direction_obj.normalized();
   auto predictor = fusion::Predictor::create(p);
   if (!predictor) return std::unexpected("onboard loop: predictor: " + predictor.error());
   auto controller = HeadController::create(options.controller);

@@ -8,6 +8,7 @@
 // a printed band), whatever the image's support; one that agrees is at least right in tilt.
 // After a gap in the IMU a wrong lock was mostly a tilt (sim-run, bus-off inside a walking step:
 // 18 deg off, 17-18 deg of it tilt), which this sees; a turn about gravity it cannot see.
+#include <cstdint>
 #include <optional>
 
 #include <Eigen/Core>
@@ -34,6 +35,9 @@ struct GravityCheckOptions {
   // Contradictions with no agreeing pose between for this long: the object was moved (its down
   // changed), so the learnt down is forgotten and learnt again.
   double forget_after_s = 5.0;
+  // A body of revolution (the tracker's free turn): its poses' turn about this axis (object
+  // frame, unit) is arbitrary, so only the angle between the axis and the down is checked.
+  std::optional<Eigen::Vector3d> free_turn_axis_obj;
 };
 
 class LearntGravity {
@@ -45,7 +49,7 @@ class LearntGravity {
   void learn(double t_s, const Eigen::Vector3d& down_obj, double sigma_rad, const Eigen::Vector3d& gyro_bias_radps,
              const Eigen::Vector3d& accel_bias_mps2, int applied_in_a_row);
   // How far the pose's tilt is from the measured down (rad); empty before anything is learnt or
-  // without a measurement.
+  // without a measurement. With a free turn axis: how far the axis's angle to the down is.
   std::optional<double> tilt_error_rad(const Eigen::Matrix3d& cam_R_obj, const std::optional<Eigen::Vector3d>& down_cam) const;
   // A pose at t_s was found to contradict (true) or agree with (false) gravity; forgets the learnt
   // down after forget_after_s of contradictions with none agreeing.
@@ -69,11 +73,25 @@ class LearntGravity {
   int forgotten_ = 0;
 };
 
-// The down direction (unit) the accelerometer measures in the IMU frame at t_s: the specific
-// force (less accel_bias) averaged over the samples of the last window_s up to t_s, each turned
-// into the IMU frame of the newest of them by the gyro (less gyro_bias), negated; it assumes no mean acceleration
-// over the window. It stops at a gap longer than dropout_gap_s (the turn across it is unknown).
-// Empty when less than min_window_s is covered or the mean is far from 1 g (a fall, garbage).
+// The specific force (less accel_bias) averaged over the samples of the last window_s up to
+// t_s, each turned into the IMU frame of the newest of them by the gyro (less gyro_bias), and the
+// samples it spans. It stops at a gap longer than dropout_gap_s (the turn across it is unknown).
+// Empty when less than min_window_s is covered.
+struct MeanForce {
+  Eigen::Vector3d mean_imu_mps2 = Eigen::Vector3d::Zero();
+  std::uint64_t oldest_seq = 0, newest_seq = 0;
+};
+std::optional<MeanForce> mean_specific_force(const StateHistory& history, double t_s, double window_s, double min_window_s,
+                                            double dropout_gap_s, const Eigen::Vector3d& gyro_bias_radps,
+                                            const Eigen::Vector3d& accel_bias_mps2);
+
+// The down direction (unit) the accelerometer measures in the IMU frame at t_s: the mean specific
+// force less the mean acceleration over the window (when known: the filter's velocity change,
+// in the same frame), negated. Without it, it assumes no mean acceleration. Empty when the result
+// is far from 1 g (a fall, garbage).
+std::optional<Eigen::Vector3d> down_from(const MeanForce& force, const Eigen::Vector3d& mean_accel_imu_mps2 = Eigen::Vector3d::Zero());
+
+// mean_specific_force and down_from with no acceleration known.
 std::optional<Eigen::Vector3d> measured_down_imu(const StateHistory& history, double t_s, double window_s,
                                                  double min_window_s, double dropout_gap_s,
                                                  const Eigen::Vector3d& gyro_bias_radps,
