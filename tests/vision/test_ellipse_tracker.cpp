@@ -5,6 +5,9 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -88,6 +91,53 @@ TEST_CASE("tracker lines are spread evenly over the contour, normal to it, arcs 
   const TrackerLine beyond = tracker_line_beyond(e, lines[29].polar_rad, 10.0, +1);
   CHECK((beyond.centre_px - lines[29].centre_px).norm() == Approx(10.0).epsilon(0.05));
   CHECK(wrap_angle(beyond.polar_rad - 2.5) > 0);
+}
+
+TEST_CASE("an arc kept in the circle's own angle lands on the same rim points under another pose", "[tracker_lines]") {
+  // A circle of radius 0.05 m seen from two poses (and from behind: the image turns the other way).
+  const Eigen::Matrix3d K = (Eigen::Matrix3d() << 500, 0, 160, 0, 500, 120, 0, 0, 1).finished();
+  auto image_of = [&](const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+    Eigen::Matrix3d H;
+    H.col(0) = 0.05 * R.col(0);
+    H.col(1) = 0.05 * R.col(1);
+    H.col(2) = t;
+    return Eigen::Matrix3d(K * H);
+  };
+  auto projection_of = [](const Eigen::Matrix3d& H) {
+    const Eigen::Matrix3d Hinv = H.inverse();
+    return *Ellipse::from_conic_matrix(Hinv.transpose() * Eigen::Vector3d(1, 1, -1).asDiagonal() * Hinv);
+  };
+  auto px = [](const Eigen::Matrix3d& H, double th) {
+    const Eigen::Vector3d p = H * Eigen::Vector3d(std::cos(th), std::sin(th), 1);
+    return Eigen::Vector2d(p.x() / p.z(), p.y() / p.z());
+  };
+  const Eigen::Vector3d t(0.01, -0.02, 0.5);
+  for (const double flip : {0.0, std::numbers::pi}) {
+    INFO("turned about x by " << flip);
+    const Eigen::Matrix3d R0 = (Eigen::AngleAxisd(flip + 0.5, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())).toRotationMatrix();
+    const Eigen::Matrix3d R1 = (Eigen::AngleAxisd(flip + 0.7, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY())).toRotationMatrix();
+    const Eigen::Matrix3d H0 = image_of(R0, t), H1 = image_of(R1, t + Eigen::Vector3d(0.02, 0, 0.05));
+    CHECK(circle_angle(H0, px(H0, 1.2)) == Approx(1.2).margin(1e-9));
+    // Rim points from th 1.0 to th 4.0 seen in the first image, ordered by growing polar angle.
+    const Ellipse e0 = projection_of(H0);
+    const double polar_a = std::atan2(px(H0, 1.0).y() - e0.centre_px.y(), px(H0, 1.0).x() - e0.centre_px.x());
+    const double polar_mid = std::atan2(px(H0, 2.5).y() - e0.centre_px.y(), px(H0, 2.5).x() - e0.centre_px.x());
+    const bool a_first = wrap_angle(polar_mid - polar_a) > 0;  // th 1 -> 4 runs the way of growing polar angle
+    const EllipseArc arc = a_first ? circle_arc_between(H0, px(H0, 1.0), px(H0, 4.0)) : circle_arc_between(H0, px(H0, 4.0), px(H0, 1.0));
+    CHECK(std::fabs(wrap_angle(arc.begin_rad - 1.0)) < 1e-9);
+    CHECK(arc.span_rad == Approx(3.0).margin(1e-9));
+    // Under the second pose, lines spread over the arc end on the images of th 1 and th 4.
+    const Ellipse e1 = projection_of(H1);
+    TrackerLine lines[30];
+    REQUIRE(spread_tracker_lines(e1, polar_arc_of(H1, e1, arc), 30, lines) > 0);
+    const Eigen::Vector2d ends[2] = {lines[0].centre_px, lines[29].centre_px};
+    const Eigen::Vector2d want_first = a_first ? px(H1, 1.0) : px(H1, 4.0), want_last = a_first ? px(H1, 4.0) : px(H1, 1.0);
+    CHECK((ends[0] - want_first).norm() < 1e-3);
+    CHECK((ends[1] - want_last).norm() < 1e-3);
+    // And the middle line is on the arc, not on the rest of the rim.
+    CHECK(circle_angle(H1, lines[15].centre_px) > 1.0);
+    CHECK(circle_angle(H1, lines[15].centre_px) < 4.0);
+  }
 }
 
 TEST_CASE("the ellipse tracker follows a moving disc on clutter to sub-pixel accuracy", "[ellipse_tracker]") {

@@ -136,7 +136,8 @@ int EllipseRansac::count_support(const Conic& k) const {
 }
 
 bool EllipseRansac::plausible(const Ellipse& e) const {
-  return e.valid() && e.semi_minor_px >= options_.min_semi_minor_px && e.semi_major_px <= options_.max_semi_major_px;
+  return e.valid() && e.semi_minor_px >= options_.min_semi_minor_px && e.semi_major_px <= options_.max_semi_major_px &&
+         e.semi_major_px >= options_.min_semi_major_px && e.semi_minor_px <= options_.max_semi_minor_px;
 }
 
 bool EllipseRansac::same_ellipse(const Ellipse& a, const Ellipse& b) const {

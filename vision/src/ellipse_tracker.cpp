@@ -34,6 +34,14 @@ WindowOptions window_options(const EllipseTrackerOptions& o) {
   return WindowOptions{std::clamp(o.width_px, 8, kMaxWindowWidth), std::max(o.lines, 3) + 2};
 }
 
+// The tracker line `spacings` spacings beyond an arc end, one spacing at a time (each follows
+// the local curvature).
+TrackerLine extension_line(const Ellipse& on, double end_polar_rad, double step_px, int spacings, int direction) {
+  TrackerLine l = tracker_line_beyond(on, end_polar_rad, step_px, direction);
+  for (int k = 1; k < spacings; ++k) l = tracker_line_beyond(on, l.polar_rad, step_px, direction);
+  return l;
+}
+
 double polar_about(const Eigen::Vector2d& centre, const Eigen::Vector2d& p) {
   return std::atan2(p.y() - centre.y(), p.x() - centre.x());
 }
@@ -60,6 +68,8 @@ void EllipseTracker::reset() {
     f.visible = f.found = f.weak = false;
     f.selected = -1;
     f.arc = {};
+    f.has_circle_arc = false;
+    f.extension_begin = f.extension_end = 1;
   }
 }
 
@@ -96,7 +106,7 @@ void EllipseTracker::track(const WindowImage& image, const VisibleModel& visible
     projection.semi_major_px = v.semi_major_px;
     projection.semi_minor_px = v.semi_minor_px;
     projection.angle_rad = v.angle_rad;
-    track_one(image, v.circle, projection, placement, v.side);
+    track_one(image, v.circle, projection, placement, v.side, &v.circle_to_px);
   }
 }
 
@@ -113,8 +123,8 @@ bool EllipseTracker::place(const WindowImage& image, EllipseFeature& f, const El
     f.arc_row_end = n;
   } else {
     step = spread_tracker_lines(on, arc, n, f.lines.data() + 1);
-    f.lines[0] = tracker_line_beyond(on, arc.begin_rad, step, -1);
-    f.lines[static_cast<std::size_t>(n) + 1] = tracker_line_beyond(on, arc.begin_rad + arc.span_rad, step, +1);
+    f.lines[0] = extension_line(on, arc.begin_rad, step, f.extension_begin, -1);
+    f.lines[static_cast<std::size_t>(n) + 1] = extension_line(on, arc.begin_rad + arc.span_rad, step, f.extension_end, +1);
     f.arc_row_begin = 1;
     f.arc_row_end = n + 1;
   }
@@ -123,7 +133,7 @@ bool EllipseTracker::place(const WindowImage& image, EllipseFeature& f, const El
 }
 
 void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
-                               ObjectSide model_side) {
+                               ObjectSide model_side, const Eigen::Matrix3d* circle_to_px) {
   if (circle < 0) return;
   EllipseFeature& f = feature(circle);
   f.visible = f.found = f.weak = false;
@@ -143,11 +153,17 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
     on = f.ellipse;
     arc = f.arc;
   } else if (placement == WindowPlacement::ProjectionOnArc && f.has_previous) {
-    arc = f.arc;  // polar angles about the centre: they carry over to the projection
+    // The arc kept in the circle's own angle lands on the same part of the rim under the new
+    // pose. Polar angles about last frame's fitted centre do not carry over to the projection:
+    // an ellipse fitted to a partly hidden rim is often 10-20 px off the projection's centre,
+    // which put the arc's lines onto the occluder.
+    arc = circle_to_px && f.has_circle_arc ? polar_arc_of(*circle_to_px, projection, f.circle_arc) : f.arc;
   }
   if (!place(image, f, on, arc)) {
     f.has_previous = false;
     f.arc = {};
+    f.has_circle_arc = false;
+    f.extension_begin = f.extension_end = 1;
     return;
   }
   f.visible = true;
@@ -159,7 +175,7 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
   }
   detector_.detect(window_.window(), f.side, f.refs, options_.mode, f.result, false, outline);
   fit(f);
-  update_arc(f);
+  update_arc(f, circle_to_px);
   if (f.found && options_.mode != EpicMode::Gradient) {
     // Re-estimate the references from the intervals beside the selected ellipse's inliers.
     const EllipseFit& c = f.candidates[static_cast<std::size_t>(f.selected)];
@@ -201,12 +217,17 @@ void EllipseTracker::fit(EllipseFeature& f) {
     px_row_[static_cast<std::size_t>(n)] = f.result.edgels.edgels[static_cast<std::size_t>(k)].row;
     ++n;
   }
-  // Between frames an axis changes by less than half a tracker line, or the lines miss it anyway.
+  // Between frames an axis changes by less than half a tracker line, or the lines miss it anyway;
+  // and by a fraction of the ellipse's size (a change of distance or tilt): without that bound
+  // a small ellipse half hidden by a board was fitted through the board's straight edge.
   EllipseRansacOptions& ro = ransac_.options();
   const double half = 0.5 * window_.width_px();
   ro.max_candidates = options_.mode == EpicMode::Epic ? options_.ransac.max_candidates : 1;
-  ro.max_semi_major_px = std::min(options_.ransac.max_semi_major_px, f.placed_on.semi_major_px + half);
-  ro.min_semi_minor_px = std::max(options_.ransac.min_semi_minor_px, f.placed_on.semi_minor_px - half);
+  const double change = std::min(half, std::max(options_.min_axis_change_px, options_.max_axis_change * f.placed_on.semi_major_px));
+  ro.max_semi_major_px = std::min(options_.ransac.max_semi_major_px, f.placed_on.semi_major_px + change);
+  ro.min_semi_major_px = std::max(options_.ransac.min_semi_major_px, f.placed_on.semi_major_px - change);
+  ro.min_semi_minor_px = std::max(options_.ransac.min_semi_minor_px, f.placed_on.semi_minor_px - change);
+  ro.max_semi_minor_px = std::min(options_.ransac.max_semi_minor_px, f.placed_on.semi_minor_px + change);
   ransac_.fit(px_x_.data(), px_y_.data(), px_row_.data(), n);
   f.ransac_iterations = ransac_.iterations();
   for (const EllipseFit& fit : ransac_.candidates()) {
@@ -257,7 +278,10 @@ void EllipseTracker::fit(EllipseFeature& f) {
   std::fill(f.row_hit.begin(), f.row_hit.end(), 0);
 }
 
-void EllipseTracker::update_arc(EllipseFeature& f) {
+void EllipseTracker::update_arc(EllipseFeature& f, const Eigen::Matrix3d* circle_to_px) {
+  f.has_circle_arc = false;
+  const int reached_begin = f.extension_begin, reached_end = f.extension_end;
+  f.extension_begin = f.extension_end = 1;
   if (!f.found) {
     f.has_previous = false;  // lost: the next frame starts again from the projection, all round
     f.arc = {};
@@ -273,6 +297,16 @@ void EllipseTracker::update_arc(EllipseFeature& f) {
     for (int r = a; r != b; r = (r + 1) % rows) span += std::fabs(wrap_angle(polar((r + 1) % rows) - polar(r)));
     return span;
   };
+  // The arc from row `first` to row `last`: polar about the fit, and in the circle's own angle
+  // when its image map was given.
+  auto set_arc = [&](int first, int last) {
+    f.arc.begin_rad = polar(first);
+    f.arc.span_rad = sweep(first, last);
+    if (!circle_to_px) return;
+    f.circle_arc = circle_arc_between(*circle_to_px, f.lines[static_cast<std::size_t>(first)].centre_px,
+                                      f.lines[static_cast<std::size_t>(last)].centre_px);
+    f.has_circle_arc = true;
+  };
   const int gap = std::max(options_.min_gap_lines, 1);
   const double line_step_rad = kTwoPi / options_.lines;
   if (f.placed_arc.full()) {
@@ -285,9 +319,7 @@ void EllipseTracker::update_arc(EllipseFeature& f) {
       if (len > best_len) { best_len = len; best_start = s; }
     }
     if (best_len < gap || best_start < 0) { f.arc = {}; f.weak = false; return; }
-    const int first = (best_start + best_len) % rows, last = (best_start + rows - 1) % rows;
-    f.arc.begin_rad = polar(first);
-    f.arc.span_rad = sweep(first, last);
+    set_arc((best_start + best_len) % rows, (best_start + rows - 1) % rows);
     ++f.occlusions;
   } else {
     // Rows run extension, arc lines, extension. The arc runs from the first to the last line
@@ -301,11 +333,18 @@ void EllipseTracker::update_arc(EllipseFeature& f) {
         last = r;
       }
     if (first < 0 || last <= first) { f.arc = {}; return; }
-    f.arc.begin_rad = polar(first);
-    f.arc.span_rad = sweep(first, last);
+    set_arc(first, last);
     if (kTwoPi - f.arc.span_rad < 1.5 * line_step_rad) {  // the ends have met: the occluder has left
       f.arc = {};
+      f.has_circle_arc = false;
       ++f.recoveries;
+    } else {
+      // An extension line that found the rim reaches twice as far next frame, but the two never
+      // beyond the middle of the gap left (the next spacing is about span / (lines - 1)).
+      const double gap_spacings = (kTwoPi - f.arc.span_rad) / f.arc.span_rad * (options_.lines - 1);
+      const int cap = std::clamp(static_cast<int>(0.5 * gap_spacings), 1, std::max(options_.max_extension_spacings, 1));
+      if (first == 0) f.extension_begin = std::min(2 * reached_begin, cap);
+      if (last == rows - 1) f.extension_end = std::min(2 * reached_end, cap);
     }
   }
   f.weak = !f.arc.full() && f.arc.span_rad < options_.weak_arc_rad;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/LU>
 #include <opencv2/core.hpp>
 
 #if defined(__SSE4_1__)
@@ -53,7 +54,42 @@ struct ArcTable {
   }
 };
 
+// Into [0, 2 pi).
+double positive_angle(double angle_rad) { return angle_rad - kTwoPi * std::floor(angle_rad / kTwoPi); }
+
+// The circle's projection turns the way of growing polar angle as th grows when the homography
+// keeps orientation: every rim point is in front of the camera (w > 0), so the sign of the
+// Jacobian of th -> px is that of det(circle_to_px).
+bool keeps_orientation(const Eigen::Matrix3d& circle_to_px) { return circle_to_px.determinant() > 0; }
+
+double polar_of_circle_point(const Eigen::Matrix3d& circle_to_px, const Eigen::Vector2d& centre_px, double th) {
+  const Eigen::Vector3d p = circle_to_px * Eigen::Vector3d(std::cos(th), std::sin(th), 1);
+  return std::atan2(p.y() / p.z() - centre_px.y(), p.x() / p.z() - centre_px.x());
+}
+
 }  // namespace
+
+double circle_angle(const Eigen::Matrix3d& circle_to_px, const Eigen::Vector2d& px) {
+  // The pixel's ray meets the circle's plane at (cos th, sin th, 1) scaled: only the direction
+  // in the plane matters, so a point a little off the projection still gives its nearest th.
+  const Eigen::Vector3d q = circle_to_px.inverse() * Eigen::Vector3d(px.x(), px.y(), 1);
+  return q.z() >= 0 ? std::atan2(q.y(), q.x()) : std::atan2(-q.y(), -q.x());
+}
+
+EllipseArc circle_arc_between(const Eigen::Matrix3d& circle_to_px, const Eigen::Vector2d& first_px,
+                              const Eigen::Vector2d& last_px) {
+  const double first = circle_angle(circle_to_px, first_px), last = circle_angle(circle_to_px, last_px);
+  if (keeps_orientation(circle_to_px)) return EllipseArc{first, positive_angle(last - first)};
+  return EllipseArc{last, positive_angle(first - last)};
+}
+
+EllipseArc polar_arc_of(const Eigen::Matrix3d& circle_to_px, const Ellipse& projection, const EllipseArc& arc) {
+  if (arc.full()) return EllipseArc{};
+  const double begin = polar_of_circle_point(circle_to_px, projection.centre_px, arc.begin_rad);
+  const double end = polar_of_circle_point(circle_to_px, projection.centre_px, arc.begin_rad + arc.span_rad);
+  if (keeps_orientation(circle_to_px)) return EllipseArc{begin, positive_angle(end - begin)};
+  return EllipseArc{end, positive_angle(begin - end)};
+}
 
 double spread_tracker_lines(const Ellipse& e, const EllipseArc& arc, int count, TrackerLine* out) {
   if (count < 2 || !e.valid() || !std::isfinite(arc.begin_rad) || !std::isfinite(arc.span_rad)) return 0;

@@ -371,6 +371,13 @@ void Visibility::add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
     ellipse.semi_minor_px = std::sqrt(-f_centre / lambda[1]);
     const Eigen::Vector2d major = eig.eigenvectors().col(0);
     ellipse.angle_rad = std::atan2(major.y(), major.x());
+    // The same image, but in the circle's own angle (a basis fixed in the object, unlike u, v).
+    const Eigen::Vector3d u_obj = circle.normal_obj.normalized().unitOrthogonal();
+    const Eigen::Vector3d v_obj = circle.normal_obj.normalized().cross(u_obj);
+    ellipse.circle_to_px.col(0) = circle.radius_m * (R * u_obj);
+    ellipse.circle_to_px.col(1) = circle.radius_m * (R * v_obj);
+    ellipse.circle_to_px.col(2) = c;
+    ellipse.circle_to_px = K * ellipse.circle_to_px;
     ellipse.facing_camera = n.dot(-c) > 0;
     const double r = ellipse.semi_major_px;
     if (centre.x() + r < 0 || centre.x() - r > camera_.width_px() || centre.y() + r < 0 ||

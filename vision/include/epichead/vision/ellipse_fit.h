@@ -35,6 +35,8 @@ struct EllipseRansacOptions {
   double min_separation_px = 2.0;   // distinct candidates differ by this in centre or an axis
   double min_semi_minor_px = 3.0;   // smaller is no trackable ellipse
   double max_semi_major_px = 5000;  // larger is a near-line through a short arc
+  // Bounds a caller sets from where the ellipse was expected (EllipseTracker): no bound by default.
+  double min_semi_major_px = 0, max_semi_minor_px = 5000;
   // Start of the sampler's random sequence, re-applied for every fit (deterministic runs); the
   // same default and the same rule as RansacOptions::seed (0 means 1).
   std::uint32_t seed = 0x9E3779B9u;

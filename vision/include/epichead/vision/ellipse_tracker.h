@@ -4,8 +4,11 @@
 // in one window, RANSAC ellipse candidates, and occlusion handling by arcs. When a run of
 // neighbouring tracker lines misses the ellipse the others agree on, the ellipse becomes the
 // arc of the lines that found it, the lines are re-spread over that arc, and one extra line
-// beyond each end watches for the occluder to leave; the arc grows back line by line. An arc
-// under 180 deg is flagged weak: an ellipse fitted to it is poorly constrained.
+// beyond each end watches for the occluder to leave; the arc grows back onto an extension line
+// that finds the rim, and that line reaches further each frame it does. On the projection
+// (the full tracker) the arc is kept in the model circle's own angle, which carries over from
+// frame to frame. An arc under 180 deg is flagged weak: an ellipse fitted to it is poorly
+// constrained.
 // Allocation-free after warm-up (each feature's buffers are reserved when first seen).
 #include <vector>
 
@@ -40,6 +43,10 @@ struct EllipseTrackerOptions {
   // Consecutive tracker lines without an inlier that break the ellipse into an arc: one line
   // may miss by noise or a specular spot, three in a row (36 deg of 30 lines) is an occluder.
   int min_gap_lines = 3;
+  // An extension line that finds the rim doubles the next one's distance beyond that arc end
+  // (1, 2, 4 ... line spacings, up to this): an occluder that leaves keeps leaving, and one
+  // spacing a frame would take some 30 frames to grow half an ellipse back.
+  int max_extension_spacings = 8;
   // Found: inliers on at least this fraction of the placed lines (and ransac.min_support).
   float min_support_ratio = 0.3f;
   // An arc that subtends less than this is weak (the fit is unstable there).
@@ -47,6 +54,10 @@ struct EllipseTrackerOptions {
   // Down-weighting of a weak arc for the pose: its EllipseObservation sigma_px is multiplied.
   double weak_sigma_factor = 3.0;
   double sigma_px = 1.0;  // EllipseObservation sigma of a strong (>= 180 deg) ellipse
+  // Between frames a semi axis changes by at most this fraction of the placed semi-major axis
+  // (at least min_axis_change_px, at most half a tracker line).
+  double max_axis_change = 0.2;
+  double min_axis_change_px = 3.0;
 };
 
 // State and latest result of one model circle.
@@ -59,13 +70,19 @@ struct EllipseFeature {
   Ellipse placed_on;              // the ellipse the tracker lines were placed on
   EllipseArc placed_arc;          // ... and the arc they were spread over
   int arc_row_begin = 0, arc_row_end = 0;  // rows of the arc lines; the others are the two extension lines
+  // How many line spacings beyond the arc's begin and end the extension lines go.
+  int extension_begin = 1, extension_end = 1;
   std::vector<TrackerLine> lines;          // this frame's rows (extension, arc lines, extension)
   EpicResult result;                       // edgels, intervals, good edgels of all rows
   std::vector<EllipseFit> candidates;      // best support first; inliers index result.edgels
   std::vector<int> candidate_inliers;      // edgel indices of the candidates
   int selected = -1;                       // index into candidates, -1 when not found
   std::vector<unsigned char> row_hit;      // per row: holds an inlier of the selected ellipse
-  EllipseArc arc;                          // the arc found this frame (where the next lines go)
+  EllipseArc arc;                          // the arc found this frame, polar angles about `ellipse`'s centre
+  // The same arc in the model circle's own angle (tracker_lines.h), when the circle's
+  // circle_to_px was given: where the next lines go under ProjectionOnArc.
+  EllipseArc circle_arc;
+  bool has_circle_arc = false;
   Ellipse ellipse;                         // the selected fit
   FeatureReferences refs;
   bool has_previous = false;               // ellipse/arc are where the next frame starts
@@ -88,9 +105,11 @@ class EllipseTracker {
   // the first time a circle is seen).
   void track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement);
   // Tracks one ellipse given directly (tests, benchmarks): `circle` indexes the features.
-  // With RimSide::Model the side is `model_side` (Both when not given).
+  // With RimSide::Model the side is `model_side` (Both when not given). With circle_to_px (the
+  // projection's VisibleEllipse::circle_to_px) an arc is also kept in the circle's own angle,
+  // and ProjectionOnArc places the lines by it.
   void track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
-                 ObjectSide model_side = ObjectSide::Both);
+                 ObjectSide model_side = ObjectSide::Both, const Eigen::Matrix3d* circle_to_px = nullptr);
   // Indexed by model circle; only entries with visible == true were processed this frame.
   const std::vector<EllipseFeature>& features() const { return features_; }
   // Image point of an edgel of a feature's result.
@@ -106,7 +125,7 @@ class EllipseTracker {
   bool place(const WindowImage& image, EllipseFeature& f, const Ellipse& on, const EllipseArc& arc);
   void fit(EllipseFeature& f);
   bool plausible(const EllipseFeature& f, const Ellipse& e) const;
-  void update_arc(EllipseFeature& f);
+  void update_arc(EllipseFeature& f, const Eigen::Matrix3d* circle_to_px);
   EllipseTrackerOptions options_;
   TrackerLineWindow window_;
   EpicDetector detector_;

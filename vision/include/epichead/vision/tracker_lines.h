@@ -33,6 +33,19 @@ struct EllipseArc {
   bool full() const { return span_rad >= 6.283185307179586 - 1e-9; }
 };
 
+// A model circle's arc in the circle's own angle th (VisibleEllipse::circle_to_px maps th to the
+// image): an EllipseArc whose angles are th, not polar angles. A rim point keeps its th from
+// frame to frame, so an arc kept in th lands on the same part of the rim under a new pose,
+// whatever ellipse was fitted to it the frame before.
+// The circle angle th of an image point on (or near) the circle's projection.
+double circle_angle(const Eigen::Matrix3d& circle_to_px, const Eigen::Vector2d& px);
+// The circle arc from the rim point seen at first_px to the one at last_px, going the way of
+// growing polar angle about the projection's centre (the way tracker lines are spread).
+EllipseArc circle_arc_between(const Eigen::Matrix3d& circle_to_px, const Eigen::Vector2d& first_px,
+                              const Eigen::Vector2d& last_px);
+// The polar arc about the centre of `projection` (the image of circle_to_px) of circle arc `arc`.
+EllipseArc polar_arc_of(const Eigen::Matrix3d& circle_to_px, const Ellipse& projection, const EllipseArc& arc);
+
 // Writes `count` tracker lines evenly spread by arc length over `arc` of `ellipse` into out[0..count):
 // the whole ellipse gets count lines one step apart all round; an arc gets its first and last
 // line on its end points. Returns the spacing in px along the contour (0 when nothing fits).

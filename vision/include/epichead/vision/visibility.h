@@ -43,6 +43,10 @@ struct VisibleEllipse {
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
   double semi_major_px = 0, semi_minor_px = 0;
   double angle_rad = 0;  // of the major axis from the image x axis
+  // Maps the circle's own angle th to the image: px ~ circle_to_px * (cos th, sin th, 1), th
+  // about normal_obj from normal_obj.unitOrthogonal(). A rim point keeps its th from frame to
+  // frame whatever the pose (EllipseTracker keeps a partly hidden rim's arc in it).
+  Eigen::Matrix3d circle_to_px = Eigen::Matrix3d::Zero();
   bool facing_camera = true;  // the circle's normal points toward the camera
   // Which side the object is on (Left = inside, as tracker-line columns run outward); set by
   // RimSides (rim_side.h), Both until then.
