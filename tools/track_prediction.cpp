@@ -1,6 +1,5 @@
 #include "track_prediction.h"
 
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
