@@ -22,15 +22,20 @@ void LineTracker::reset() {
 }
 
 void LineTracker::reserve(int edges) {
-  if (edges > static_cast<int>(features_.size())) {
-    features_.resize(static_cast<std::size_t>(edges));
-    longest_.resize(features_.size());
-  }
-  for (LineFeature& f : features_) {
-    if (f.reserved) continue;
-    f.result.reserve(options_.window, options_.epic.ransac);
-    f.reserved = true;
-  }
+  grow_to(edges);
+  for (LineFeature& f : features_) reserve_buffers(f);
+}
+
+void LineTracker::grow_to(int edges) {
+  if (edges <= static_cast<int>(features_.size())) return;
+  features_.resize(static_cast<std::size_t>(edges));
+  longest_.resize(features_.size());
+}
+
+void LineTracker::reserve_buffers(LineFeature& f) const {
+  if (f.reserved) return;
+  f.result.reserve(options_.window, options_.epic.ransac);
+  f.reserved = true;
 }
 
 void LineTracker::track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
@@ -45,10 +50,7 @@ void LineTracker::track(const WindowImage& image, const VisibleModel& visible, W
 void LineTracker::detect(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement) {
   int max_edge = -1;
   for (const VisibleEdge& e : visible.edges) max_edge = std::max(max_edge, e.edge);
-  if (max_edge >= static_cast<int>(features_.size())) {  // first frame (warm-up)
-    features_.resize(static_cast<std::size_t>(max_edge) + 1);
-    longest_.resize(features_.size());
-  }
+  grow_to(max_edge + 1);  // first frame (warm-up), unless reserve() came first
   std::fill(longest_.begin(), longest_.end(), -1);
   for (int i = 0; i < static_cast<int>(visible.edges.size()); ++i) {
     const VisibleEdge& e = visible.edges[i];
@@ -92,10 +94,7 @@ bool LineTracker::has_close_parallel(const VisibleModel& visible, int edge) cons
 
 void LineTracker::detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement,
                              bool look_through, LineFeature& f) {
-  if (!f.reserved) {
-    f.result.reserve(options_.window, options_.epic.ransac);
-    f.reserved = true;
-  }
+  reserve_buffers(f);
   f.side = piece.side;
   f.piece = piece;
   if (!f.refs.initialised && options_.mode != EpicMode::Gradient) {

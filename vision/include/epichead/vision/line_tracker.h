@@ -94,6 +94,10 @@ class LineTracker {
   void reserve(int edges);
 
  private:
+  // features_ (and longest_) for edge indices below `edges`.
+  void grow_to(int edges);
+  // A feature's window buffers, sized the first time only.
+  void reserve_buffers(LineFeature& f) const;
   void detect_one(const WindowImage& image, const VisibleEdge& piece, WindowPlacement placement, bool look_through,
                   LineFeature& f);
   bool has_close_parallel(const VisibleModel& visible, int edge) const;
