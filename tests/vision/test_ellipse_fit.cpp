@@ -166,3 +166,21 @@ TEST_CASE("RANSAC gives no candidate for too few, collinear or non-finite points
   CHECK(ransac.fit(xn.data(), yn.data(), nullptr, 20) == 0);
   CHECK_FALSE(fit_ellipse_direct(xn.data(), yn.data(), nullptr, 20));
 }
+
+TEST_CASE("two arcs overlap on the longest piece both cover, across the wrap at pi", "[ellipse]") {
+  using epichead::vision::EllipseArc;
+  const EllipseArc full{};
+  const EllipseArc a{2.5, 2.0};  // 2.5 .. 4.5 rad, across +-pi
+  auto same = [](const std::optional<EllipseArc>& x, double begin, double span) {
+    REQUIRE(x.has_value());
+    CHECK(std::remainder(x->begin_rad - begin, 2 * M_PI) == Approx(0).margin(1e-12));
+    CHECK(x->span_rad == Approx(span));
+  };
+  same(EllipseArc::overlap(full, a), 2.5, 2.0);
+  same(EllipseArc::overlap(a, full), 2.5, 2.0);
+  same(EllipseArc::overlap(a, EllipseArc{-2.0, 1.0}), -2.0 + 2 * M_PI, 4.5 - (-2.0 + 2 * M_PI));
+  same(EllipseArc::overlap(a, EllipseArc{3.0, 0.5}), 3.0, 0.5);  // inside
+  CHECK_FALSE(EllipseArc::overlap(a, EllipseArc{0.0, 1.0}).has_value());
+  // Two pieces (b runs from inside a round the circle into a again): the longer one.
+  same(EllipseArc::overlap(a, EllipseArc{4.2, 6.0}), 2.5, 4.2 + 6.0 - 2 * M_PI - 2.5);
+}

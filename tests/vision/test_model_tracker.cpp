@@ -254,14 +254,13 @@ TEST_CASE("the full tracker keeps tracking while a board covers part of a circle
 }
 
 // Known gap (issue 19 item 6): EllipseTracker on its own re-spreads the arc's lines onto the part
-// in view and grows the arc back within ten frames (test_ellipse_tracker.cpp), but inside the
-// full tracker the arc's lines stay 5-17 px onto the board and the ellipse never becomes whole
-// again. Seen frame by frame: under the board the ellipse fitted to the arc has its centre 10-20 px
-// off the projection's, the arc's ends are kept as polar angles about that fitted centre and
-// applied about the projection's next frame (ProjectionOnArc), so the lines land on the board,
-// find nothing, and the arc shrinks (5.45 -> 2.68 rad in six frames); after the board it grows
-// back by only ~0.07 rad a frame. An arc kept in the model circle's own angle would carry over.
-// Take [!shouldfail] off when fixed.
+// in view and grows the arc back within ten frames (test_ellipse_tracker.cpp); inside the full
+// tracker, under the board, 11 arc-line placements still land more than 3 px onto the board and
+// the arc never grows back into a whole ellipse by itself (no recovery is counted; the ellipse is
+// whole again only because it is lost and placed afresh from the projection). The arc's ends are
+// kept as polar angles about the fitted centre and applied about the projection's next frame
+// (ProjectionOnArc); an arc kept in the model circle's own angle would carry over (branch
+// arc-fix, docs/epic.md). Take [!shouldfail] off when fixed.
 TEST_CASE("the full tracker places the arc's lines on the part in view and recovers the whole ellipse after", "[!shouldfail]") {
   const CoveredDiscRun run = run_covered_disc();
   CHECK(run.arc_lines_under_board == 0);

@@ -416,3 +416,66 @@ TEST_CASE("cylinder limbs are tangent: the whole surface lies on the axis side o
     CHECK(min_offset < 0.05);   // and touching it
   }
 }
+
+namespace {
+
+// Whether polar angle `a` lies on `arc` (within `slack_rad` of it).
+bool on_arc(const EllipseArc& arc, double a, double slack_rad) {
+  const double d = std::fmod(std::fmod(a - arc.begin_rad + slack_rad, 2 * M_PI) + 2 * M_PI, 2 * M_PI);
+  return d <= arc.span_rad + 2 * slack_rad;
+}
+
+}  // namespace
+
+TEST_CASE("a can's bottom rim seen from above is seen only on its near half, its top rim all round", "[visibility]") {
+  // 32 facets with their corners on the rims, as CAO users model a can.
+  std::vector<Eigen::Vector2d> profile;
+  for (int i = 0; i < 32; ++i) profile.emplace_back(0.04 * std::cos(i * M_PI / 16), 0.04 * std::sin(i * M_PI / 16));
+  CadModel model = make_prism(profile, 0.1);
+  for (const double z : {0.0, 0.1}) {
+    ModelCircle rim;
+    rim.centre_obj = {0, 0, z};
+    rim.normal_obj = Eigen::Vector3d::UnitZ();
+    rim.radius_m = 0.04;
+    model.circles.push_back(rim);
+  }
+  const Camera camera = test_camera();
+  const Eigen::Vector3d eye(0.05, -0.45, 0.25);  // in front of the can and above it
+  const auto pose = camera_at(eye, {0, 0, 0.05});
+  const VisibleModel out = compute_visibility(model, camera, pose);
+  REQUIRE(out.ellipses.size() == 2);
+  for (const VisibleEllipse& el : out.ellipses) {
+    const bool bottom = model.circles[static_cast<std::size_t>(el.circle)].centre_obj.z() < 0.05;
+    INFO((bottom ? "bottom rim" : "top rim") << ": seen from " << el.seen.begin_rad << " over " << el.seen.span_rad);
+    if (!bottom) {
+      CHECK(el.seen.full());
+      continue;
+    }
+    CHECK(el.seen.span_rad > 0.8 * M_PI);
+    CHECK(el.seen.span_rad < 1.3 * M_PI);
+    // Rim points turned toward the camera are on the seen arc, those turned away are not.
+    const Eigen::Vector2d toward = Eigen::Vector2d(eye.x(), eye.y()).normalized();
+    for (int k = 0; k < 72; ++k) {
+      const double th = k * M_PI / 36;
+      const Eigen::Vector2d radial(std::cos(th), std::sin(th));
+      const Eigen::Vector2d px = camera.project(pose * Eigen::Vector3d(0.04 * radial.x(), 0.04 * radial.y(), 0));
+      const double polar = std::atan2(px.y() - el.centre_px.y(), px.x() - el.centre_px.x());
+      const double facing = radial.dot(toward);
+      INFO("rim point at " << th << " rad, facing " << facing);
+      if (facing > 0.3) CHECK(on_arc(el.seen, polar, 0.0));
+      if (facing < -0.3) CHECK_FALSE(on_arc(el.seen, polar, 0.0));
+    }
+  }
+}
+
+TEST_CASE("a rim hidden all round by its own body is left out", "[visibility]") {
+  // A disc inside a box: the circle lies in the middle of the box, never seen.
+  CadModel model = make_cube();
+  ModelCircle inner;
+  inner.centre_obj = {0.05, 0.05, 0.05};
+  inner.normal_obj = Eigen::Vector3d::UnitZ();
+  inner.radius_m = 0.02;
+  model.circles.push_back(inner);
+  const VisibleModel out = compute_visibility(model, test_camera(), camera_at({0.3, -0.4, 0.5}, {0.05, 0.05, 0.05}));
+  CHECK(out.ellipses.empty());
+}

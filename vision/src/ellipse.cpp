@@ -97,6 +97,22 @@ double Ellipse::polar_of_param(double t) const {
   return std::atan2(d.y(), d.x());
 }
 
+std::optional<EllipseArc> EllipseArc::overlap(const EllipseArc& a, const EllipseArc& b) {
+  if (a.full()) return b;
+  if (b.full()) return a;
+  constexpr double two_pi = 6.283185307179586;
+  // b's begin measured from a's, in [0, 2 pi): b covers [d, d + span] and, wrapped once,
+  // [d - 2 pi, d - 2 pi + span] of a's [0, span].
+  const double d = std::fmod(std::fmod(b.begin_rad - a.begin_rad, two_pi) + two_pi, two_pi);
+  double best_lo = 0, best_len = 0;
+  for (const double start : {d, d - two_pi}) {
+    const double lo = std::max(0.0, start), hi = std::min(a.span_rad, start + b.span_rad);
+    if (hi - lo > best_len) { best_lo = lo; best_len = hi - lo; }
+  }
+  if (!(best_len > 0)) return std::nullopt;
+  return EllipseArc{a.begin_rad + best_lo, best_len};
+}
+
 double Ellipse::distance(const Eigen::Vector2d& p) const {
   const Conic k = conic();
   const double q = conic_value(k, p.x(), p.y());

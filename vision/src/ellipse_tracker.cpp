@@ -96,7 +96,7 @@ void EllipseTracker::track(const WindowImage& image, const VisibleModel& visible
     projection.semi_major_px = v.semi_major_px;
     projection.semi_minor_px = v.semi_minor_px;
     projection.angle_rad = v.angle_rad;
-    track_one(image, v.circle, projection, placement, v.side);
+    track_one(image, v.circle, projection, placement, v.side, v.seen);
   }
 }
 
@@ -123,7 +123,7 @@ bool EllipseTracker::place(const WindowImage& image, EllipseFeature& f, const El
 }
 
 void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
-                               ObjectSide model_side) {
+                               ObjectSide model_side, const EllipseArc& seen) {
   if (circle < 0) return;
   EllipseFeature& f = feature(circle);
   f.visible = f.found = f.weak = false;
@@ -134,17 +134,20 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
   f.side = options_.side == RimSide::Model ? model_side : object_side(options_.side);
   if (!projection.valid()) { f.has_previous = false; return; }
   if (!f.refs.initialised && options_.mode != EpicMode::Gradient) {
-    // References from both sides of the projected contour, whatever the placement.
-    if (place(image, f, projection, EllipseArc{})) detector_.init_references(window_.window(), f.side, f.refs);
+    // References from both sides of the seen projected contour, whatever the placement.
+    if (place(image, f, projection, seen)) detector_.init_references(window_.window(), f.side, f.refs);
   }
   Ellipse on = projection;
-  EllipseArc arc;
+  EllipseArc arc = seen;
   if (placement == WindowPlacement::Previous && f.has_previous) {
     on = f.ellipse;
     arc = f.arc;
   } else if (placement == WindowPlacement::ProjectionOnArc && f.has_previous) {
     arc = f.arc;  // polar angles about the centre: they carry over to the projection
   }
+  // Never onto the part the model hides (an arc found last frame may have grown into it).
+  if (const auto both = EllipseArc::overlap(arc, seen)) arc = *both;
+  else arc = seen;
   if (!place(image, f, on, arc)) {
     f.has_previous = false;
     f.arc = {};
@@ -177,6 +180,18 @@ Eigen::Vector2d EllipseTracker::edgel_px(const EllipseFeature& f, int edgel) con
   return l.centre_px + static_cast<double>(e.x_px) * l.normal;
 }
 
+bool EllipseTracker::placed_shape(const EllipseFeature& f, const Ellipse& e) const {
+  // The prediction fixes a circle's image to a few percent in size (its distance) and a few
+  // degrees in openness (semi-minor / semi-major, the cosine of the angle between the line of
+  // sight and the circle's axis). A candidate much larger, smaller, flatter or rounder is
+  // another contour: a band printed round a can just below its top rim, joined with the rim's
+  // own far arc, fits an ellipse 15-25 % larger and twice as open.
+  const Ellipse& p = f.placed_on;
+  return !p.valid() || !e.valid() ||
+         (std::abs(e.semi_major_px / p.semi_major_px - 1) <= options_.max_size_change &&
+          std::abs(e.semi_minor_px / e.semi_major_px - p.semi_minor_px / p.semi_major_px) <= options_.max_openness_change);
+}
+
 bool EllipseTracker::plausible(const EllipseFeature& f, const Ellipse& e) const {
   // The new contour must cross every arc line inside its window: an ellipse fitted to a short
   // arc can otherwise swing far from where any line looked (it has no support there).
@@ -190,6 +205,73 @@ bool EllipseTracker::plausible(const EllipseFeature& f, const Ellipse& e) const 
     if (!(q * q <= half * half * (gx * gx + gy * gy))) return false;
   }
   return true;
+}
+
+bool EllipseTracker::moved_placement(EllipseFeature& f, EllipseFit& out) const {
+  // Edgel k lies x_k along its line's normal n_k from the placed contour. Moving the placed
+  // ellipse by s and scaling it by (1 + k) about its centre c moves the contour at line point p
+  // by n.s + k (p - c).n along n. Hypotheses: the shift through two edgels of lines at least
+  // 30 deg apart; then shift and scale refitted to the best one's inliers.
+  const std::vector<int>& good = f.result.good;
+  const int n = static_cast<int>(good.size());
+  if (n < 5) return false;
+  const double tol = options_.ransac.inlier_distance_px;
+  const Eigen::Vector2d c = f.placed_on.centre_px;
+  auto edgel = [&](int i) -> const Edgel& { return f.result.edgels.edgels[static_cast<std::size_t>(good[static_cast<std::size_t>(i)])]; };
+  auto line = [&](int i) -> const TrackerLine& { return f.lines[static_cast<std::size_t>(edgel(i).row)]; };
+  // What the placed contour moved by `shift` and scaled by 1 + `scale` leaves of edgel i's offset.
+  auto residual = [&](int i, const Eigen::Vector2d& shift, double scale) {
+    const TrackerLine& l = line(i);
+    return static_cast<double>(edgel(i).x_px) - l.normal.dot(shift) - scale * (l.centre_px - c).dot(l.normal);
+  };
+  auto count = [&](const Eigen::Vector2d& shift) {
+    int inliers = 0;
+    for (int i = 0; i < n; ++i) inliers += std::abs(residual(i, shift, 0)) <= tol;
+    return inliers;
+  };
+  // Deterministic pairs spread over the edgels: at most kPairs of them.
+  constexpr int kPairs = 96;
+  const int stride = std::max(1, n * (n - 1) / 2 / kPairs);
+  Eigen::Vector2d best_shift = Eigen::Vector2d::Zero();
+  int best = -1, pair = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j, ++pair) {
+      if (pair % stride != 0) continue;
+      const Eigen::Vector2d& ni = line(i).normal;
+      const Eigen::Vector2d& nj = line(j).normal;
+      const double det = ni.x() * nj.y() - ni.y() * nj.x();
+      if (std::abs(det) < 0.5) continue;  // lines closer than 30 deg: the shift along them is unseen
+      const double xi = edgel(i).x_px, xj = edgel(j).x_px;
+      const Eigen::Vector2d shift((xi * nj.y() - xj * ni.y()) / det, (ni.x() * xj - nj.x() * xi) / det);
+      const int support = count(shift);
+      if (support > best) { best = support; best_shift = shift; }
+    }
+  if (best < 5) return false;
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    if (std::abs(residual(i, best_shift, 0)) > tol) continue;
+    const TrackerLine& l = line(i);
+    const Eigen::Vector3d j(l.normal.x(), l.normal.y(), (l.centre_px - c).dot(l.normal));
+    A.noalias() += j * j.transpose();
+    b += static_cast<double>(edgel(i).x_px) * j;
+  }
+  A.diagonal().array() += 1e-6 * A.trace() + 1e-9;
+  const Eigen::Vector3d fit = A.ldlt().solve(b);
+  const Eigen::Vector2d shift = fit.head<2>();
+  const double scale = std::abs(fit.z()) <= options_.max_size_change ? fit.z() : 0.0;
+  out = EllipseFit{};
+  out.ellipse = f.placed_on;
+  out.ellipse.centre_px += shift;
+  out.ellipse.semi_major_px *= 1 + scale;
+  out.ellipse.semi_minor_px *= 1 + scale;
+  out.inlier_begin = static_cast<int>(f.candidate_inliers.size());
+  for (int i = 0; i < n; ++i) {
+    if (std::abs(residual(i, shift, scale)) > tol) continue;
+    f.candidate_inliers.push_back(good[static_cast<std::size_t>(i)]);
+    ++out.support;
+  }
+  return out.support >= 5;
 }
 
 void EllipseTracker::fit(EllipseFeature& f) {
@@ -216,15 +298,30 @@ void EllipseTracker::fit(EllipseFeature& f) {
       f.candidate_inliers.push_back(f.result.good[static_cast<std::size_t>(ransac_.inliers()[static_cast<std::size_t>(fit.inlier_begin + q)])]);
     f.candidates.push_back(c);
   }
-  // Select the best-supported plausible candidate with inliers on enough tracker lines
-  // (topology validation may later choose among the candidates instead).
+  // Select the best-supported plausible candidate of the placed shape with inliers on enough
+  // tracker lines (topology validation may later choose among the candidates instead). When
+  // free fits were refused only for their shape, they are other contours: last in line comes
+  // the placed ellipse moved onto the edgels it explains (a rim half under a board or a lamp's
+  // arm, whose best free fit runs along the occluder's edge).
   const int arc_lines = f.arc_row_end - f.arc_row_begin;
   const int need = std::max(std::max(options_.ransac.min_support, 5),
                             static_cast<int>(std::ceil(options_.min_support_ratio * static_cast<float>(arc_lines))));
   f.row_hit.assign(f.lines.size(), 0);
-  for (int c = 0; c < static_cast<int>(f.candidates.size()); ++c) {
+  bool other_shape = false, moved_tried = false;
+  for (int c = 0;; ++c) {
+    if (c == static_cast<int>(f.candidates.size())) {
+      if (!other_shape || moved_tried || options_.mode != EpicMode::Epic || !f.placed_arc.full()) break;
+      moved_tried = true;
+      EllipseFit moved;
+      if (!moved_placement(f, moved)) break;
+      f.candidates.push_back(moved);  // within the reserved capacity
+    }
     const EllipseFit& cand = f.candidates[static_cast<std::size_t>(c)];
     if (!plausible(f, cand.ellipse)) continue;
+    if (!placed_shape(f, cand.ellipse)) {
+      other_shape = true;
+      continue;
+    }
     std::fill(f.row_hit.begin(), f.row_hit.end(), 0);
     for (int q = 0; q < cand.support; ++q)
       f.row_hit[static_cast<std::size_t>(f.result.edgels.edgels[static_cast<std::size_t>(f.candidate_inliers[static_cast<std::size_t>(cand.inlier_begin + q)])].row)] = 1;

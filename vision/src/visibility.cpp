@@ -15,8 +15,10 @@
 #include "epichead/vision/visibility.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -194,7 +196,8 @@ bool Visibility::clip_to_view(const Eigen::Vector3d& A, const Eigen::Vector3d& B
 
 // hidden_: the sorted intervals of [lo, hi] of the segment hidden by a triangle of a face other
 // than the segment's own; n0, n1 the clipped ends in normalised coordinates.
-void Visibility::find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1) {
+void Visibility::find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1,
+                             double depth_margin_m) {
   const Eigen::Vector3d& A = seg.a_cam;
   const Eigen::Vector3d& B = seg.b_cam;
   const float bx0 = static_cast<float>(std::min(n0.x(), n1.x())), bx1 = static_cast<float>(std::max(n0.x(), n1.x()));
@@ -234,7 +237,7 @@ void Visibility::find_hidden(const Segment& seg, double lo, double hi, const Eig
     const Eigen::Vector3d nu = nrm / nn;
     const double d = nu.dot(V0);
     const double sgn = d > 0 ? 1.0 : -1.0;
-    const double depth_tol = 1e-6 + 1e-7 * std::abs(d);
+    const double depth_tol = 1e-6 + 1e-7 * std::abs(d) + depth_margin_m;
     clip_linear(sgn * (nu.dot(A) - d), sgn * (nu.dot(B) - d), depth_tol, s0, s1);
     if (s1 > s0) hidden_.emplace_back(s0, s1);
   }
@@ -376,8 +379,59 @@ void Visibility::add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
     if (centre.x() + r < 0 || centre.x() - r > camera_.width_px() || centre.y() + r < 0 ||
         centre.y() - r > camera_.height_px())
       continue;
+    if (!seen_arc(circle, c, u, v, centre, ellipse.seen)) continue;
     out.ellipses.push_back(ellipse);
   }
+}
+
+// The circle as kChords chords, each tested at its middle against the occluders like an edge.
+// No face counts as the circle's own, but a face hides a point only from further in front than
+// a tenth of the radius: a rim modelled by facets runs up to the facets' sagitta inside or
+// outside them, while what really hides a rim (the body in front of its far half) is a
+// diameter away. The seen arc is the longest run of seen chords, from the middle of its first
+// chord to the middle of its last: never onto a hidden part.
+bool Visibility::seen_arc(const ModelCircle& circle, const Eigen::Vector3d& c, const Eigen::Vector3d& u,
+                          const Eigen::Vector3d& v, const Eigen::Vector2d& centre_px, EllipseArc& arc) {
+  constexpr int kChords = 48;
+  constexpr double kStep = 2 * std::numbers::pi / kChords;
+  auto at = [&](double th) -> Eigen::Vector3d { return c + circle.radius_m * (std::cos(th) * u + std::sin(th) * v); };
+  std::array<unsigned char, kChords> chord_seen{};
+  int seen = 0;
+  for (int k = 0; k < kChords; ++k) {
+    const Eigen::Vector3d A = at(k * kStep), B = at((k + 1) * kStep);
+    const Segment chord{A, B, A, B, -1, -1, -1, EdgeKind::Contour, A, false};
+    find_hidden(chord, 0.0, 1.0, normalized(A), normalized(B), 0.1 * circle.radius_m);
+    bool hidden = false;
+    for (const auto& [h0, h1] : hidden_) hidden = hidden || (h0 <= 0.5 && 0.5 <= h1);
+    chord_seen[static_cast<std::size_t>(k)] = !hidden;
+    seen += !hidden;
+  }
+  arc = EllipseArc{};
+  if (seen == kChords) return true;
+  if (seen == 0) return false;
+  // The longest cyclic run of seen chords: it starts after a hidden one.
+  int best_start = 0, best_len = 0;
+  for (int s = 0; s < kChords; ++s) {
+    if (!chord_seen[static_cast<std::size_t>(s)] || chord_seen[static_cast<std::size_t>((s + kChords - 1) % kChords)]) continue;
+    int len = 0;
+    while (len < kChords && chord_seen[static_cast<std::size_t>((s + len) % kChords)]) ++len;
+    if (len > best_len) { best_start = s; best_len = len; }
+  }
+  const Eigen::Matrix3d K = camera_.K();
+  auto polar = [&](double th) {
+    const Eigen::Vector3d p = K * at(th);
+    return std::atan2(p.y() / p.z() - centre_px.y(), p.x() / p.z() - centre_px.x());
+  };
+  auto forward = [](double from, double to) {  // angle swept from `from` to `to` growing, in [0, 2 pi)
+    const double two_pi = 2 * std::numbers::pi;
+    return std::fmod(std::fmod(to - from, two_pi) + two_pi, two_pi);
+  };
+  const double th0 = (best_start + 0.5) * kStep, th1 = (best_start + best_len - 0.5) * kStep;
+  const double p0 = polar(th0), p1 = polar(th1), pm = polar(0.5 * (th0 + th1));
+  // The image may run the circle either way round: the arc is the way that passes its middle.
+  if (forward(p0, pm) <= forward(p0, p1)) arc = EllipseArc{p0, forward(p0, p1)};
+  else arc = EllipseArc{p1, forward(p1, p0)};
+  return true;
 }
 
 VisibleModel compute_visibility(const CadModel& model, const Camera& camera, const Eigen::Isometry3d& cam_T_obj,

@@ -39,6 +39,17 @@ struct Ellipse {
   double distance(const Eigen::Vector2d& p_px) const;
 };
 
+// An arc of an ellipse's contour: polar angles begin_rad .. begin_rad + span_rad about the
+// centre, in the direction of growing angle. span_rad >= 2 pi is the whole ellipse.
+struct EllipseArc {
+  double begin_rad = 0;
+  double span_rad = 6.283185307179586;
+  bool full() const { return span_rad >= 6.283185307179586 - 1e-9; }
+  // The longest piece both arcs cover (angles taken about the same centre); nullopt when they
+  // do not overlap.
+  static std::optional<EllipseArc> overlap(const EllipseArc& a, const EllipseArc& b);
+};
+
 // Signed evaluation Q(p) of conic coefficients and its gradient, for fits and support counts.
 inline double conic_value(const Conic& k, double x, double y) {
   return k[0] * x * x + k[1] * x * y + k[2] * y * y + k[3] * x + k[4] * y + k[5];

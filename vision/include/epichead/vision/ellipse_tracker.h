@@ -47,6 +47,12 @@ struct EllipseTrackerOptions {
   // Down-weighting of a weak arc for the pose: its EllipseObservation sigma_px is multiplied.
   double weak_sigma_factor = 3.0;
   double sigma_px = 1.0;  // EllipseObservation sigma of a strong (>= 180 deg) ellipse
+  // Largest changes of a fitted ellipse from the one its lines were placed on (the prediction
+  // or the last fit): of its semi-major axis, relative (0.1: the circle 10 % nearer or
+  // further), and of its openness, semi-minor / semi-major (0.1: the line of sight turned ~6 deg
+  // against the circle).
+  double max_size_change = 0.1;
+  double max_openness_change = 0.1;
 };
 
 // State and latest result of one model circle.
@@ -88,9 +94,10 @@ class EllipseTracker {
   // the first time a circle is seen).
   void track(const WindowImage& image, const VisibleModel& visible, WindowPlacement placement);
   // Tracks one ellipse given directly (tests, benchmarks): `circle` indexes the features.
-  // With RimSide::Model the side is `model_side` (Both when not given).
+  // With RimSide::Model the side is `model_side` (Both when not given). Tracker lines go only
+  // on `seen` (VisibleEllipse::seen: the part the model's own faces leave in view).
   void track_one(const WindowImage& image, int circle, const Ellipse& projection, WindowPlacement placement,
-                 ObjectSide model_side = ObjectSide::Both);
+                 ObjectSide model_side = ObjectSide::Both, const EllipseArc& seen = {});
   // Indexed by model circle; only entries with visible == true were processed this frame.
   const std::vector<EllipseFeature>& features() const { return features_; }
   // Image point of an edgel of a feature's result.
@@ -105,7 +112,14 @@ class EllipseTracker {
   EllipseFeature& feature(int circle);
   bool place(const WindowImage& image, EllipseFeature& f, const Ellipse& on, const EllipseArc& arc);
   void fit(EllipseFeature& f);
+  // Whether e crosses every arc line inside its window.
   bool plausible(const EllipseFeature& f, const Ellipse& e) const;
+  // Whether e has the size and openness of the ellipse the lines were placed on.
+  bool placed_shape(const EllipseFeature& f, const Ellipse& e) const;
+  // The placed ellipse moved (shift, and scale within max_size_change) onto the good edgels
+  // most of which it explains; false when fewer than five. Appends its inliers to
+  // f.candidate_inliers.
+  bool moved_placement(EllipseFeature& f, EllipseFit& out) const;
   void update_arc(EllipseFeature& f);
   EllipseTrackerOptions options_;
   TrackerLineWindow window_;

@@ -25,14 +25,6 @@ struct TrackerLine {
   double polar_rad = 0;
 };
 
-// An arc of an ellipse's contour: polar angles begin_rad .. begin_rad + span_rad about the
-// centre, in the direction of growing angle. span_rad >= 2 pi is the whole ellipse.
-struct EllipseArc {
-  double begin_rad = 0;
-  double span_rad = 6.283185307179586;
-  bool full() const { return span_rad >= 6.283185307179586 - 1e-9; }
-};
-
 // Writes `count` tracker lines evenly spread by arc length over `arc` of `ellipse` into out[0..count):
 // the whole ellipse gets count lines one step apart all round; an arc gets its first and last
 // line on its end points. Returns the spacing in px along the contour (0 when nothing fits).

@@ -9,6 +9,7 @@
 
 #include "epichead/vision/camera.h"
 #include "epichead/vision/cao_model.h"
+#include "epichead/vision/ellipse.h"
 
 namespace epichead::vision {
 
@@ -44,6 +45,11 @@ struct VisibleEllipse {
   double semi_major_px = 0, semi_minor_px = 0;
   double angle_rad = 0;  // of the major axis from the image x axis
   bool facing_camera = true;  // the circle's normal points toward the camera
+  // The part of the contour no face of the model hides, in polar angles about centre_px: the
+  // far half of a can's bottom rim seen from above is behind the can, where tracker lines
+  // would find only its print. Full when nothing hides it; a circle hidden all round is left
+  // out of VisibleModel.
+  EllipseArc seen;
   // Which side the object is on (Left = inside, as tracker-line columns run outward); set by
   // RimSides (rim_side.h), Both until then.
   ObjectSide side = ObjectSide::Both;
@@ -99,8 +105,14 @@ class Visibility {
   void add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, VisibleModel& out);
   // Clipping of one segment: to the view, then by the occluders, then its visible pieces.
   bool clip_to_view(const Eigen::Vector3d& A, const Eigen::Vector3d& B, double& lo, double& hi) const;
-  void find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1);
+  // depth_margin_m: a triangle hides only what lies further than this behind its plane.
+  void find_hidden(const Segment& seg, double lo, double hi, const Eigen::Vector2d& n0, const Eigen::Vector2d& n1,
+                   double depth_margin_m = 0);
   void emit_segment(const Segment& seg, VisibleModel& out);
+  // The arc of a circle's image (centre c, in-plane unit axes u and v, camera frame) that the
+  // occluders leave seen; false when they hide all of it.
+  bool seen_arc(const ModelCircle& circle, const Eigen::Vector3d& c, const Eigen::Vector3d& u, const Eigen::Vector3d& v,
+                const Eigen::Vector2d& centre_px, EllipseArc& arc);
 
   const CadModel* model_;
   Camera camera_;
