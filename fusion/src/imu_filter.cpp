@@ -173,6 +173,14 @@ std::optional<PosePrediction> ImuFilter::predict(double t_s) const {
   return out;
 }
 
+StateEntry* ImuFilter::newest_sample_state() {
+  if (history_.empty() || history_.end_seq() <= history_.first_state_seq()) return nullptr;
+  const StateEntry* anchor = history_.anchor();
+  StateEntry& e = history_.at(history_.end_seq() - 1);
+  if (anchor && anchor->sample.t_s > e.sample.t_s) return nullptr;  // a pose applied ahead of it
+  return &e;
+}
+
 double ImuFilter::update_t_s() const {
   const StateEntry* a = history_.anchor();
   return a ? a->sample.t_s : 0;
