@@ -92,6 +92,7 @@ const char* to_string(VisionVerdict v) {
     case VisionVerdict::BadInput: return "bad-input";
     case VisionVerdict::NoImu: return "no-imu";
     case VisionVerdict::AgainstGravity: return "against-gravity";
+    case VisionVerdict::Unchecked: return "unchecked";
   }
   return "?";
 }
@@ -226,6 +227,12 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
     // about to be replaced, may be the one that is wrong).
     if (check_tilt(t_s, cam_T_obj)) return {VisionVerdict::AgainstGravity, 0};
+    // After a run of gated poses, one that cannot be checked (the accelerometer's window is cut by
+    // a gap) may be the wrong lock the gap caused: the filter waits for one that can be.
+    if (initialised_ && options_.mode == PredictorMode::ImuAided && gravity_.learnt() && !measured_down_cam(t_s)) {
+      ++c.vision_unchecked;
+      return {VisionVerdict::Unchecked, 0};
+    }
     if (!f.initialise(t_s, cam_T_obj, cov)) {
       ++c.vision_no_imu;
       return {VisionVerdict::NoImu, 0};

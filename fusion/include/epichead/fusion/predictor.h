@@ -51,6 +51,9 @@ enum class VisionVerdict {
   NoImu,        // ImuAided: no accelerometer reading near the exposure time to initialise gravity
   AgainstGravity,  // ImuAided: a (re-)initialisation refused, the pose's tilt contradicts the
                    // learnt down (learnt_gravity.h)
+  Unchecked,       // ImuAided: a re-initialisation after gated poses refused while the down is
+                   // learnt but cannot be measured at the exposure (the window is cut by a gap):
+                   // right after an IMU gap the tracker's pose may be a tilted wrong lock
 };
 
 const char* to_string(ImuVerdict verdict);
@@ -71,6 +74,7 @@ struct PredictorCounters {
                 vision_out_of_order = 0, vision_bad_input = 0, vision_no_imu = 0;
   std::uint64_t vision_against_gravity = 0;  // poses check_tilt() or a re-initialisation found tilted
   std::uint64_t gravity_forgotten = 0;       // learnt downs forgotten after a long run of contradictions
+  std::uint64_t vision_unchecked = 0;        // re-initialisations refused: tilt not measurable (Unchecked)
   std::uint64_t unaided_down_updates = 0;    // tilt updates from the accelerometer without vision
   std::uint64_t unaided_tilt_contradictions = 0;  // of those, the filter's own tilt contradicted gravity
   std::uint64_t unaided_position_holds = 0;  // position held near the last verified one without vision
