@@ -180,6 +180,9 @@ void Predictor::update_unaided(double t_s) {
   if (!e) return;
   PredictorCounters& c = status_.counters;
   if (gravity_.learnt() && t_s >= next_down_t_s_) {
+    // A window too short (after a gap) or a camera accelerating: tried again a tenth of the period
+    // later, not at every sample (each try turns up to window_s of samples: ~20 us).
+    next_down_t_s_ = t_s + 0.1 * u.period_s;
     // The down without the filter's mean acceleration: unaided, its velocity is its own propagation,
     // and the acceleration from it would only give back the filter's own tilt.
     const GravityCheckOptions& g = options_.gravity_check;
