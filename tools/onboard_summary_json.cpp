@@ -75,7 +75,12 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                          {"vision_applied", s.predictor.vision_applied},
                          {"vision_gated", s.predictor.vision_gated},
                          {"dropouts", s.predictor.dropouts},
-                         {"reinitialisations", s.predictor.reinitialisations}}}};
+                         {"reinitialisations", s.predictor.reinitialisations},
+                         {"vision_against_gravity", s.predictor.vision_against_gravity},
+                         {"vision_unchecked", s.predictor.vision_unchecked},
+                         {"unaided_down_updates", s.predictor.unaided_down_updates},
+                         {"unaided_tilt_contradictions", s.predictor.unaided_tilt_contradictions},
+                         {"unaided_position_holds", s.predictor.unaided_position_holds}}}};
 }
 
 }  // namespace epichead::tools

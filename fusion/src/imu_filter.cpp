@@ -47,6 +47,17 @@ bool ImuFilter::state_at(double t_s, StateEntry& out, double& extrapolated_s) co
     out.sample = base->sample;
     out.sample.t_s = t_s;
     extrapolated_s = t_s - base->sample.t_s;
+    if (extrapolated_s > options_.coast_after_s) {
+      // Coasting (no sample for longer than the bus's latency): over the gap the acceleration is
+      // unknown with mean zero (the dropout inflation's model), so the reading held at the
+      // extrapolation's end is the one of a camera that does not accelerate. Holding the last one
+      // instead integrated a walking step's peak over the whole gap: 0.3 s of bus-off inside a
+      // burst left the velocity 1.5 m/s off (docs/fusion.md, "Without vision"). Shorter
+      // extrapolations (the newest sample's latency, the 5 ms look-ahead of the clock offset's
+      // uncertainty) keep the held reading.
+      const Eigen::Matrix3d imu_R_obj = (base->x.obj_R_cam * options_.mount.cam_R_imu).transpose();
+      out.sample.accel_mps2 = base->x.accel_bias_mps2 - imu_R_obj * base->x.gravity_obj_mps2();
+    }
   }
   step(out.x, out.P, base->sample, out.sample);
   return true;
@@ -171,6 +182,14 @@ std::optional<PosePrediction> ImuFilter::predict(double t_s) const {
   out.cam_T_obj = e.x.cam_T_obj();
   out.covariance = H * e.P * H.transpose();
   return out;
+}
+
+StateEntry* ImuFilter::newest_sample_state() {
+  if (history_.empty() || history_.end_seq() <= history_.first_state_seq()) return nullptr;
+  const StateEntry* anchor = history_.anchor();
+  StateEntry& e = history_.at(history_.end_seq() - 1);
+  if (anchor && anchor->sample.t_s > e.sample.t_s) return nullptr;  // a pose applied ahead of it
+  return &e;
 }
 
 double ImuFilter::update_t_s() const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "epichead/fusion/unaided_update.h"
 
 namespace epichead::fusion {
 namespace {
@@ -54,6 +55,10 @@ std::expected<void, std::string> check(const PredictorOptions& o) {
       !non_negative(g.min_window_s) || g.min_window_s > g.window_s || !positive(g.max_tilt_error_rad) ||
       !positive(g.forget_after_s))
     return bad("gravity_check", "needs learn_after_applied >= 1, 0 <= min_window_s <= window_s and the rest finite and > 0");
+  const UnaidedOptions& u = o.unaided;
+  if (!positive(u.after_s) || !positive(u.period_s) || !positive(u.down_sigma_rad) || !positive(u.max_force_error) ||
+      !positive(u.position_sigma_m))
+    return bad("unaided", "must be finite and > 0");
   const ConstantVelocityNoise& c = o.cv_noise;
   if (!positive(c.accel_mps2_rths) || !positive(c.angular_accel_radps2_rths) || !positive(c.initial_speed_mps) ||
       !positive(c.initial_rate_radps))
@@ -87,6 +92,7 @@ const char* to_string(VisionVerdict v) {
     case VisionVerdict::BadInput: return "bad-input";
     case VisionVerdict::NoImu: return "no-imu";
     case VisionVerdict::AgainstGravity: return "against-gravity";
+    case VisionVerdict::Unchecked: return "unchecked";
   }
   return "?";
 }
@@ -163,7 +169,49 @@ ImuVerdict Predictor::add_imu(const ImuSample& in) {
   status_.newest_imu_t_s = s.t_s;
   if (!propagated) { ++c.imu_buffered; return ImuVerdict::Buffered; }
   ++c.imu_accepted;
+  update_unaided(s.t_s);
   return ImuVerdict::Accepted;
+}
+
+void Predictor::update_unaided(double t_s) {
+  const UnaidedOptions& u = options_.unaided;
+  if (!u.enabled || !initialised_ || t_s - status_.last_update_t_s < u.after_s) return;
+  StateEntry* e = imu_.newest_sample_state();
+  if (!e) return;
+  PredictorCounters& c = status_.counters;
+  if (gravity_.learnt() && t_s >= next_down_t_s_) {
+    // A window too short (after a gap) or a camera accelerating: tried again a tenth of the period
+    // later, not at every sample (each try turns up to window_s of samples: ~20 us).
+    next_down_t_s_ = t_s + 0.1 * u.period_s;
+    // The down without the filter's mean acceleration: unaided, its velocity is its own propagation,
+    // and the acceleration from it would only give back the filter's own tilt.
+    const GravityCheckOptions& g = options_.gravity_check;
+    const std::optional<MeanForce> force = mean_specific_force(imu_.history(), t_s, g.window_s, g.min_window_s, options_.dropout_gap_s,
+                                                               gravity_.gyro_bias_radps(), gravity_.accel_bias_mps2());
+    if (force && std::abs(force->mean_imu_mps2.norm() - standard_gravity_mps2) <= u.max_force_error * standard_gravity_mps2)
+      if (const std::optional<Eigen::Vector3d> down_imu = down_from(*force)) {
+        const Eigen::Vector3d down_cam = options_.mount.cam_R_imu * *down_imu;
+        // A body of revolution: its turn about the axis is the tracker's choice, so of the learnt
+        // down only its angle to the axis is known; the down on that cone nearest the measured one.
+        Eigen::Vector3d down_obj = gravity_.down_obj();
+        if (const auto& axis = g.free_turn_axis_obj) {
+          const Eigen::Vector3d m_obj = e->x.obj_R_cam * down_cam;
+          const Eigen::Vector3d across = m_obj - m_obj.dot(*axis) * *axis;
+          if (across.norm() > 1e-6) {
+            const double cos_a = std::clamp(down_obj.dot(*axis), -1.0, 1.0);
+            down_obj = cos_a * *axis + std::sqrt(1 - cos_a * cos_a) * across.normalized();
+          }
+        }
+        const DownUpdateResult r = update_down(e->x, e->P, down_obj, down_cam, u.down_sigma_rad, g.max_tilt_error_rad);
+        c.unaided_down_updates += r.applied;
+        c.unaided_tilt_contradictions += r.inflated;
+        next_down_t_s_ = t_s + u.period_s;
+      }
+  }
+  if (have_hold_ && t_s >= next_hold_t_s_) {
+    next_hold_t_s_ = t_s + u.period_s;
+    if (hold_position(e->x, e->P, hold_obj_p_cam_, u.position_sigma_m)) ++c.unaided_position_holds;
+  }
 }
 
 VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov_in) {
@@ -182,6 +230,12 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
     // about to be replaced, may be the one that is wrong).
     if (check_tilt(t_s, cam_T_obj)) return {VisionVerdict::AgainstGravity, 0};
+    // After a run of gated poses, one that cannot be checked (the accelerometer's window is cut by
+    // a gap) may be the wrong lock the gap caused: the filter waits for one that can be.
+    if (initialised_ && options_.mode == PredictorMode::ImuAided && gravity_.learnt() && !measured_down_cam(t_s)) {
+      ++c.vision_unchecked;
+      return {VisionVerdict::Unchecked, 0};
+    }
     if (!f.initialise(t_s, cam_T_obj, cov)) {
       ++c.vision_no_imu;
       return {VisionVerdict::NoImu, 0};
@@ -193,6 +247,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     status_.gated_in_a_row = 0;
     applied_in_a_row_ = 0;
     status_.last_update_t_s = t_s;
+    note_hold(t_s, cam_T_obj);
     return {VisionVerdict::Initialised, 0};
   }
   // Poses come in exposure order; one older than the last applied would undo it on re-propagation.
@@ -216,12 +271,27 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   status_.last_nis = r->mahalanobis2;
   status_.last_update_t_s = t_s;
   ++applied_in_a_row_;
+  note_hold(t_s, cam_T_obj);
   if (options_.mode == PredictorMode::ImuAided)
     if (const StateEntry* e = imu_.newest_state()) {
       const double sigma = std::sqrt(e->P.block<2, 2>(err::grav, err::grav).diagonal().maxCoeff());
       gravity_.learn(t_s, e->x.gravity_obj_mps2(), sigma, e->x.gyro_bias_radps, e->x.accel_bias_mps2, applied_in_a_row_);
     }
   return {VisionVerdict::Applied, r->mahalanobis2};
+}
+
+void Predictor::note_hold(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+  if (options_.mode != PredictorMode::ImuAided) return;
+  const StateEntry* anchor = imu_.history().anchor();
+  if (!anchor) return;
+  // A pose the accelerometer could not check (right after a gap) may be a wrong lock; one it
+  // contradicted the caller did not give.
+  if (gravity_.learnt()) {
+    const std::optional<double> e = tilt_error_rad(t_s, cam_T_obj);
+    if (!e || *e > options_.gravity_check.max_tilt_error_rad) return;
+  }
+  hold_obj_p_cam_ = anchor->x.obj_p_cam;
+  have_hold_ = true;
 }
 
 std::optional<Eigen::Vector3d> Predictor::measured_down_cam(double t_s) const {

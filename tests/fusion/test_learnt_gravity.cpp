@@ -138,6 +138,33 @@ TEST_CASE("after a reset the predictor refuses to start again from a tilted pose
   CHECK(run.predictor.add_vision(t, truth, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
 }
 
+TEST_CASE("right after an IMU gap, a run of gated poses does not restart the filter from a pose the accelerometer cannot check yet") {
+  Tracked run(2.0);
+  REQUIRE(run.predictor.learnt_down_obj());
+  // A 0.3 s gap in the IMU (a bus-off): its samples never come.
+  const double gap_end = run.t_s + 0.3;
+  for (; run.next < run.imu.samples.size() && run.imu.samples[run.next].t_s < gap_end; ++run.next) {}
+  // Poses 0.5 m off are gated, five in a row ask for a re-initialisation (reinit_after_gated).
+  double t = gap_end;
+  Eigen::Isometry3d off = run.traj.at(t).x.cam_T_obj();
+  for (int i = 0; i < 5; ++i) {
+    t += 0.005;
+    run.feed_until(t + 0.001);
+    off = run.traj.at(t).x.cam_T_obj();
+    off.translation().x() += 0.5;
+    CHECK(run.predictor.add_vision(t, off, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Gated);
+  }
+  // 0.03 s after the gap: less than min_window_s (0.15 s) of accelerometer to check a tilt with.
+  t = gap_end + 0.03;
+  run.feed_until(t + 0.001);
+  CHECK(run.predictor.add_vision(t, run.traj.at(t).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Unchecked);
+  CHECK(run.predictor.status(t).counters.vision_unchecked == 1);
+  // Once the window is there, an upright pose restarts it.
+  t = gap_end + 0.2;
+  run.feed_until(t + 0.001);
+  CHECK(run.predictor.add_vision(t, run.traj.at(t).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
+}
+
 TEST_CASE("contradictions for longer than forget_after_s forget the learnt down, an agreeing pose between restarts the count") {
   PredictorOptions options;
   options.gravity_check.forget_after_s = 1.0;

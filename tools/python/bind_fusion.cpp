@@ -31,7 +31,10 @@ py::dict counters_dict(const PredictorCounters& c) {
                   py::arg("vision_too_old") = c.vision_too_old, py::arg("vision_out_of_order") = c.vision_out_of_order,
                   py::arg("vision_bad_input") = c.vision_bad_input, py::arg("vision_no_imu") = c.vision_no_imu,
                   py::arg("vision_against_gravity") = c.vision_against_gravity,
-                  py::arg("gravity_forgotten") = c.gravity_forgotten, py::arg("reinitialisations") = c.reinitialisations,
+                  py::arg("gravity_forgotten") = c.gravity_forgotten, py::arg("vision_unchecked") = c.vision_unchecked,
+                  py::arg("unaided_down_updates") = c.unaided_down_updates,
+                  py::arg("unaided_tilt_contradictions") = c.unaided_tilt_contradictions,
+                  py::arg("unaided_position_holds") = c.unaided_position_holds, py::arg("reinitialisations") = c.reinitialisations,
                   py::arg("repropagated_samples") = c.repropagated_samples);
 }
 

@@ -43,6 +43,9 @@ class ImuFilter final : public PoseFilter {
   const StateHistory& history() const { return history_; }
   // The newest state (sample or anchor); null before initialisation.
   const StateEntry* newest_state() const { return history_.newest_state(); }
+  // The newest sample's entry when it carries a state, for an update in place at that sample (the
+  // unaided updates); null otherwise. A later vision pose older than it re-propagates over it.
+  StateEntry* newest_sample_state();
   std::uint64_t repropagated_samples() const { return repropagated_samples_; }
 
  private:

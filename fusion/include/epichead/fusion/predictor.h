@@ -51,6 +51,9 @@ enum class VisionVerdict {
   NoImu,        // ImuAided: no accelerometer reading near the exposure time to initialise gravity
   AgainstGravity,  // ImuAided: a (re-)initialisation refused, the pose's tilt contradicts the
                    // learnt down (learnt_gravity.h)
+  Unchecked,       // ImuAided: a re-initialisation after gated poses refused while the down is
+                   // learnt but cannot be measured at the exposure (the window is cut by a gap):
+                   // right after an IMU gap the tracker's pose may be a tilted wrong lock
 };
 
 const char* to_string(ImuVerdict verdict);
@@ -71,6 +74,10 @@ struct PredictorCounters {
                 vision_out_of_order = 0, vision_bad_input = 0, vision_no_imu = 0;
   std::uint64_t vision_against_gravity = 0;  // poses check_tilt() or a re-initialisation found tilted
   std::uint64_t gravity_forgotten = 0;       // learnt downs forgotten after a long run of contradictions
+  std::uint64_t vision_unchecked = 0;        // re-initialisations refused: tilt not measurable (Unchecked)
+  std::uint64_t unaided_down_updates = 0;    // tilt updates from the accelerometer without vision
+  std::uint64_t unaided_tilt_contradictions = 0;  // of those, the filter's own tilt contradicted gravity
+  std::uint64_t unaided_position_holds = 0;  // position held near the last verified one without vision
   std::uint64_t reinitialisations = 0;  // initialisations after the first (reset or gated run)
   std::uint64_t repropagated_samples = 0;
 };
@@ -129,6 +136,13 @@ class Predictor {
 
  private:
   explicit Predictor(const PredictorOptions& options);
+  // Without vision for options_.unaided.after_s: the tilt and position updates of unaided_update.h
+  // on the state of the sample at t_s (the newest), once per options_.unaided.period_s.
+  void update_unaided(double t_s);
+  // After an applied or initialising pose at t_s: its camera position (the filter's, after the
+  // update) becomes the one the unaided filter is held near, unless the accelerometer could not
+  // check the pose's tilt or contradicted it.
+  void note_hold(double t_s, const Eigen::Isometry3d& cam_T_obj);
   // The filter of options_.mode.
   PoseFilter& filter();
   const PoseFilter& filter() const;
@@ -142,6 +156,11 @@ class Predictor {
   bool reinit_pending_ = false;
   int applied_in_a_row_ = 0;
   LearntGravity gravity_;
+  double next_down_t_s_ = 0, next_hold_t_s_ = 0;  // the next unaided updates are due at these sample times
+  // The camera position after the last applied pose that the accelerometer did not contradict
+  // (or any, before a down is learnt): where the unaided filter is held.
+  bool have_hold_ = false;
+  Eigen::Vector3d hold_obj_p_cam_ = Eigen::Vector3d::Zero();
   PredictorStatus status_;
 };
 

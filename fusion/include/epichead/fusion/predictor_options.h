@@ -11,6 +11,27 @@ namespace epichead::fusion {
 
 enum class PredictorMode { ImuAided, ConstantVelocity };
 
+// Mode::ImuAided without vision (unaided_update.h, docs/fusion.md "Without vision"): once no pose
+// has been applied for after_s, every period_s of IMU time the filter's tilt is updated from the
+// accelerometer's down (when the object's down is learnt) and its position held near the last one
+// vision verified.
+struct UnaidedOptions {
+  bool enabled = true;
+  double after_s = 0.2;           // no applied pose for this long (six frames at 30 Hz)
+  double period_s = 0.2;          // one update of each kind per this much IMU time: the windows
+                                  // (gravity_check.window_s) of consecutive ones overlap by half
+  // The measured down's 1-sigma per tilt direction: the camera's mean acceleration over the window,
+  // which the filter cannot take off while it is unaided (its own velocity then only repeats its
+  // own tilt), up to about 0.5 m/s^2 walking (3 deg).
+  double down_sigma_rad = 0.05;
+  // No tilt update while the mean specific force's magnitude is off g by more than this share of g:
+  // the camera accelerates on average along gravity, and likely across it as well.
+  double max_force_error = 0.05;
+  // How far from where vision last verified it the camera may be (a robot's step): the position
+  // is held within this while the filter's own sigma is larger.
+  double position_sigma_m = 0.2;
+};
+
 struct PredictorOptions {
   PredictorMode mode = PredictorMode::ImuAided;
   ImuNoise imu_noise;
@@ -44,6 +65,7 @@ struct PredictorOptions {
   double initial_accel_bias_mps2 = 0.2;
   ConstantVelocityNoise cv_noise;       // Mode::ConstantVelocity
   GravityCheckOptions gravity_check;    // Mode::ImuAided: poses checked against the learnt down
+  UnaidedOptions unaided;               // Mode::ImuAided: tilt and position while vision is absent
 };
 
 }  // namespace epichead::fusion
