@@ -399,6 +399,7 @@ bool Visibility::seen_arc(const ModelCircle& circle, const Eigen::Vector3d& c, c
   int seen = 0;
   for (int k = 0; k < kChords; ++k) {
     const Eigen::Vector3d A = at(k * kStep), B = at((k + 1) * kStep);
+    // find_hidden reads only the camera-frame ends and the own faces (none) of a segment.
     const Segment chord{A, B, A, B, -1, -1, -1, EdgeKind::Contour, A, false};
     find_hidden(chord, 0.0, 1.0, normalized(A), normalized(B), 0.1 * circle.radius_m);
     bool hidden = false;
