@@ -4,6 +4,7 @@
 // refinement and verification, detect()).
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -27,7 +28,7 @@ inline std::string class_id(int view, int roll) { return "v" + std::to_string(vi
 struct Detector::Impl {
   Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
       : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
-        tracker(model_storage, c, without_outline_colours(t)), visibility(model_storage, c, t.visibility),
+        tracker(model_storage, c, without_outline_colours(t)), visibility(model_storage, c, whole_circles(t.visibility)),
         symmetries(model_symmetries(m)) {}
 
   // A hypothesis can be off by more than the outline colours' margins, and then draws the
@@ -39,12 +40,22 @@ struct Detector::Impl {
   }
 
   // The pull's windows are twice as wide as tracking's: a template's pose can be off by more
-  // than a frame's motion.
+  // than a frame's motion. For the same reason its rims may change size and openness freely:
+  // the limits that refuse another contour in tracking (a prediction a few percent off) would
+  // refuse the rim itself from a template half a grid step away in distance and view.
   static ModelTrackerOptions wide(ModelTrackerOptions t) {
     t = without_outline_colours(t);
     t.lines.window.width_px = std::min(kMaxWindowWidth, 2 * t.lines.window.width_px);
     t.max_jump_px = 2 * t.max_jump_px;
+    t.ellipses.max_size_change = std::numeric_limits<double>::infinity();
+    t.ellipses.max_openness_change = std::numeric_limits<double>::infinity();
     return t;
+  }
+
+  // The quick scores and the verification sample whole ellipses: no need to clip them.
+  static VisibilityOptions whole_circles(VisibilityOptions v) {
+    v.clip_circles = false;
+    return v;
   }
 
   // The detector keeps its own copy of the model: the trackers and visibility refer to it, and

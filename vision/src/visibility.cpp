@@ -379,7 +379,7 @@ void Visibility::add_circles(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
     if (centre.x() + r < 0 || centre.x() - r > camera_.width_px() || centre.y() + r < 0 ||
         centre.y() - r > camera_.height_px())
       continue;
-    if (!seen_arc(circle, c, u, v, centre, ellipse.seen)) continue;
+    if (options_.clip_circles && !seen_arc(circle, c, u, v, centre, ellipse.seen)) continue;
     out.ellipses.push_back(ellipse);
   }
 }

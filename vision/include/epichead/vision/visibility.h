@@ -70,6 +70,10 @@ struct VisibilityOptions {
   // ViSP's face appearance angle (which measures from the face's centre). 90 deg keeps every
   // front face; facets of smooth surfaces and open models always keep the strict test.
   double max_view_angle_rad = 85.0 * 3.14159265358979323846 / 180.0;
+  // Clip circles by the model's faces (VisibleEllipse::seen; 48 occlusion tests per circle).
+  // Off, every circle in front of the camera is seen whole: the detector's quick scores, which
+  // sample whole ellipses anyway, run it thousands of times per frame.
+  bool clip_circles = true;
 };
 
 struct VisibleModel {
