@@ -17,9 +17,7 @@ namespace geometry = epichead::geometry;
 
 namespace {
 
-constexpr double deg = M_PI / 180;
-
-double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+constexpr double deg = kDegRad;
 
 // The truth's pose turned by `angle_rad` about `axis_cam` (camera frame).
 Eigen::Isometry3d turned(const Eigen::Isometry3d& cam_T_obj, const Eigen::Vector3d& axis_cam, double angle_rad) {

@@ -17,9 +17,7 @@ namespace geometry = epichead::geometry;
 
 namespace {
 
-constexpr double deg = M_PI / 180;
-
-double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+constexpr double deg = kDegRad;
 
 // A filter state looking along the object's z with the object's down along -y, its covariance
 // `sigma_rad` in rotation and 1 cm in position.

@@ -2,6 +2,7 @@
 // A deterministic truth generator for the fusion tests: a smooth camera trajectory with closed-form
 // derivatives, the exact IMU readings it produces (specific force with gravity), and seeded noise,
 // biases and vision poses drawn from the distributions the filter assumes.
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -79,6 +80,13 @@ Matrix6d pose_cov(double sigma_m, double sigma_rad);
 
 // Wilson-Hilferty approximation of the chi-square quantile (accurate to < 1 % for dof > 30).
 double chi2_quantile(double p, double dof);
+
+inline constexpr double kDegRad = M_PI / 180;
+
+// The angle between two directions, rad (atan2: exact near 0 and pi).
+inline double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
 
 template <class Predictor, class Callback>
 void run_scenario(Predictor& predictor, const Trajectory& traj, const ImuRun& imu, double time_offset_s,
