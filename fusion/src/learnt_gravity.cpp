@@ -38,6 +38,15 @@ std::optional<double> LearntGravity::tilt_error_rad(const Eigen::Matrix3d& cam_R
   return angle(cam_R_obj * down_obj_, *down_cam);
 }
 
+Eigen::Vector3d LearntGravity::down_obj_toward(const Eigen::Vector3d& measured_down_obj) const {
+  const auto& axis = options_.free_turn_axis_obj;
+  if (!axis) return down_obj_;
+  const Eigen::Vector3d across = measured_down_obj - measured_down_obj.dot(*axis) * *axis;
+  if (!(across.norm() > 1e-6)) return down_obj_;
+  const double cos_a = std::clamp(down_obj_.dot(*axis), -1.0, 1.0);
+  return cos_a * *axis + std::sqrt(1 - cos_a * cos_a) * across.normalized();
+}
+
 void LearntGravity::note_verdict(double t_s, bool contradicts) {
   if (!contradicts) {
     contradicted_since_s_ = -1;

@@ -191,17 +191,8 @@ void Predictor::update_unaided(double t_s) {
     if (force && std::abs(force->mean_imu_mps2.norm() - standard_gravity_mps2) <= u.max_force_error * standard_gravity_mps2)
       if (const std::optional<Eigen::Vector3d> down_imu = down_from(*force)) {
         const Eigen::Vector3d down_cam = options_.mount.cam_R_imu * *down_imu;
-        // A body of revolution: its turn about the axis is the tracker's choice, so of the learnt
-        // down only its angle to the axis is known; the down on that cone nearest the measured one.
-        Eigen::Vector3d down_obj = gravity_.down_obj();
-        if (const auto& axis = g.free_turn_axis_obj) {
-          const Eigen::Vector3d m_obj = e->x.obj_R_cam * down_cam;
-          const Eigen::Vector3d across = m_obj - m_obj.dot(*axis) * *axis;
-          if (across.norm() > 1e-6) {
-            const double cos_a = std::clamp(down_obj.dot(*axis), -1.0, 1.0);
-            down_obj = cos_a * *axis + std::sqrt(1 - cos_a * cos_a) * across.normalized();
-          }
-        }
+        // A body of revolution: of the learnt down only its angle to the axis is known.
+        const Eigen::Vector3d down_obj = gravity_.down_obj_toward(e->x.obj_R_cam * down_cam);
         const DownUpdateResult r = update_down(e->x, e->P, down_obj, down_cam, u.down_sigma_rad, g.max_tilt_error_rad);
         c.unaided_down_updates += r.applied;
         c.unaided_tilt_contradictions += r.inflated;

@@ -57,6 +57,10 @@ class LearntGravity {
 
   bool learnt() const { return learnt_; }
   const Eigen::Vector3d& down_obj() const { return down_obj_; }
+  // The learnt down for a pose that puts the measured down at `measured_down_obj` (object
+  // frame): the learnt one, or with a free turn axis, of the downs at the learnt angle to the axis
+  // (all equally right, the turn being the tracker's choice) the one nearest the measured.
+  Eigen::Vector3d down_obj_toward(const Eigen::Vector3d& measured_down_obj) const;
   const Eigen::Vector3d& gyro_bias_radps() const { return gyro_bias_radps_; }
   const Eigen::Vector3d& accel_bias_mps2() const { return accel_bias_mps2_; }
   int forgotten() const { return forgotten_; }
