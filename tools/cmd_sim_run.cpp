@@ -82,6 +82,15 @@ std::expected<std::int64_t, std::string> parse_log_epoch(const std::string& text
   return std::llround(s * 1e6);
 }
 
+// One frame's pose errors against the truth at its exposure. The tracker's own (NaN when lost)
+// beside the prediction's tells a prediction that ran off from a tracker that settled on a
+// wrong pose (the predictor then follows it).
+struct FrameError {
+  double t_s = 0;
+  double predicted_attitude_deg = 0, tracked_attitude_deg = 0;
+  double predicted_position_mm = 0, tracked_position_mm = 0;
+};
+
 // What one closed run measured against the simulator's truth.
 struct RunMeasures {
   double cam_rate_rms_degps = 0;       // camera angular rate on the image-shifting axes (x, y)
@@ -95,14 +104,11 @@ struct RunMeasures {
   plot::Series pan{"pan (deg)", {}, {}}, tilt{"tilt (deg)", {}, {}};
   plot::Series centring{"target from centre (px)", {}, {}};
   // --soak: resident memory (KiB) once warmed up, at the end and at most (sampled every 10 s of
-  // simulated time inside the run; the end is the last such sample), and the predictor's
-  // attitude error at each frame's exposure (t_s, deg).
+  // simulated time inside the run; the end is the last such sample), and the pose errors at
+  // each frame's exposure.
   double rss_warm_kib = 0, rss_end_kib = 0, rss_max_kib = 0;
-  std::vector<std::pair<double, double>> attitude_error_deg;  // sized (and touched) before the run
-  // The tracker's own attitude error on the same frames (NaN when lost): tells a prediction that
-  // ran off from a tracker that settled on a wrong pose (the predictor then follows it).
-  std::vector<double> tracked_attitude_error_deg;
-  std::size_t attitude_errors = 0;                            // entries filled
+  std::vector<FrameError> errors;  // sized (and touched) before the run
+  std::size_t errors_filled = 0;
 };
 
 // One frame's overlay PNG: the model at the tracker's pose, captioned. Returns whether it was written.
@@ -211,14 +217,19 @@ class TruthMeter {
 void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunArgs& a,
                    const std::vector<Eigen::Isometry3d>& symmetries, RunMeasures& m) {
   if (a.soak) {
-    if (auto truth = w.truth_at(f.exposure_t_s)) {
-      const Eigen::Matrix3d d = f.predicted_cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
-      if (m.attitude_errors < m.attitude_error_deg.size()) {
-        const Eigen::Matrix3d dt = f.report->cam_T_obj.linear() * truth->cam_T_obj.linear().transpose();
-        m.tracked_attitude_error_deg[m.attitude_errors] =
-            f.status == vision::TrackStatus::Lost ? std::nan("") : Eigen::AngleAxisd(dt).angle() * 180 / M_PI;
-        m.attitude_error_deg[m.attitude_errors++] = {f.exposure_t_s, Eigen::AngleAxisd(d).angle() * 180 / M_PI};
-      }
+    auto truth = w.truth_at(f.exposure_t_s);
+    if (truth && m.errors_filled < m.errors.size()) {
+      const auto angle_deg = [&](const Eigen::Isometry3d& p) {
+        return Eigen::AngleAxisd(p.linear() * truth->cam_T_obj.linear().transpose()).angle() * 180 / M_PI;
+      };
+      const auto distance_mm = [&](const Eigen::Isometry3d& p) {
+        return (p.translation() - truth->cam_T_obj.translation()).norm() * 1e3;
+      };
+      const bool lost = f.status == vision::TrackStatus::Lost;
+      m.errors[m.errors_filled++] = {f.exposure_t_s, angle_deg(f.predicted_cam_T_obj),
+                                     lost ? std::nan("") : angle_deg(f.report->cam_T_obj),
+                                     distance_mm(f.predicted_cam_T_obj),
+                                     lost ? std::nan("") : distance_mm(f.report->cam_T_obj)};
     }
   }
   const auto& covers = w.scenario().covers;
@@ -314,10 +325,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   int overlays = 0;
   const double until = a.seconds > 0 ? a.seconds : scenario.first_frame_s + scenario.frames / scenario.fps;
   // Sized up front (so its pages are resident before the baseline): the measuring must not grow.
-  if (a.soak) {
-    m.attitude_error_deg.assign(static_cast<std::size_t>(until * scenario.fps) + 16, {0.0, 0.0});
-    m.tracked_attitude_error_deg.assign(m.attitude_error_deg.size(), 0.0);
-  }
+  if (a.soak) m.errors.assign(static_cast<std::size_t>(until * scenario.fps) + 16, FrameError{});
   const head::FrameHook hook = [&](const head::TrackedFrame& f) {
     measure_frame(f, w, a, symmetries, m);
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
@@ -325,16 +333,16 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   };
   auto summary = (*loop)->run(std::min(until, w.horizon_s()), hook);
   if (!summary) return summary;
-  m.attitude_error_deg.resize(m.attitude_errors);
+  m.errors.resize(m.errors_filled);
   meter.finish();
   return summary;
 }
 
-// Median of the attitude errors with t_s in [t0, t1), or -1 when there are none.
-double median_error_deg(const std::vector<std::pair<double, double>>& errors, double t0, double t1) {
+// Median of the predicted attitude errors with t_s in [t0, t1), or -1 when there are none.
+double median_error_deg(const std::vector<FrameError>& errors, double t0, double t1) {
   std::vector<double> v;
-  for (const auto& [t, e] : errors)
-    if (t >= t0 && t < t1) v.push_back(e);
+  for (const FrameError& e : errors)
+    if (e.t_s >= t0 && e.t_s < t1) v.push_back(e.predicted_attitude_deg);
   if (v.empty()) return -1;
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
   return v[v.size() / 2];
@@ -343,10 +351,10 @@ double median_error_deg(const std::vector<std::pair<double, double>>& errors, do
 // --soak: memory after warm-up and at the end, the predictor's attitude error early and late,
 // the loop's summary (faults and recoveries are in diagnostics.jsonl's events).
 int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::OnboardSummary& run, const RunMeasures& m) {
-  const double end_s = m.attitude_error_deg.empty() ? 0 : m.attitude_error_deg.back().first;
+  const double end_s = m.errors.empty() ? 0 : m.errors.back().t_s;
   const double window_s = std::max(1.0, 0.1 * (end_s - a.soak_warmup_s));
-  const double early = median_error_deg(m.attitude_error_deg, a.soak_warmup_s, a.soak_warmup_s + window_s);
-  const double late = median_error_deg(m.attitude_error_deg, end_s - window_s, end_s + 1);
+  const double early = median_error_deg(m.errors, a.soak_warmup_s, a.soak_warmup_s + window_s);
+  const double late = median_error_deg(m.errors, end_s - window_s, end_s + 1);
   const nlohmann::json j{{"scenario", scenario.name},
                          {"mode", a.mode},
                          {"seed", scenario.seed},
@@ -365,10 +373,11 @@ int report_soak(const sim::Scenario& scenario, const SimRunArgs& a, const head::
   // The error at every frame, for finding when and how it grew.
   const std::string errors_path = (fs::path(a.out) / "attitude_error.csv").string();
   std::ofstream errors(errors_path);
-  errors << "t_s,predicted_attitude_error_deg,tracked_attitude_error_deg\n";
-  for (std::size_t i = 0; i < m.attitude_error_deg.size(); ++i)
-    errors << m.attitude_error_deg[i].first << ',' << m.attitude_error_deg[i].second << ','
-           << m.tracked_attitude_error_deg[i] << '\n';
+  errors << "t_s,predicted_attitude_error_deg,tracked_attitude_error_deg,predicted_position_error_mm,"
+            "tracked_position_error_mm\n";
+  for (const FrameError& e : m.errors)
+    errors << e.t_s << ',' << e.predicted_attitude_deg << ',' << e.tracked_attitude_deg << ','
+           << e.predicted_position_mm << ',' << e.tracked_position_mm << '\n';
   std::printf("sim-run %s --soak (%s, seed %llu): %.0f s simulated, %d frames (%llu tracked, %llu lost)\n",
               scenario.name.c_str(), a.mode.c_str(), static_cast<unsigned long long>(scenario.seed), end_s, m.frames,
               static_cast<unsigned long long>(run.tracked), static_cast<unsigned long long>(run.lost));

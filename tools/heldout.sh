@@ -13,6 +13,8 @@
 #   --frames N      simulate only the first N frames (default: the scenario's own)
 #   --modes         tracker modes (default: gradient epic epic+validation); the table then
 #                   has rows for these only
+#   --imu "on off"  which IMU settings to track with (default: both; "on" after a change
+#                   that only the IMU path sees)
 #   --jobs J        sequences simulated and tracked at once (default: nproc)
 # Environment: EPICHEAD_BIN, the program to run (default: build/bin/epichead of this checkout).
 # Needs jq.
@@ -42,8 +44,10 @@ one() {
   fi
   local rows="$out/rows/$scenario-$seed.tsv"
   : > "$rows.part"
-  local imus=(off)
-  [[ -f "$seq/imu.csv" ]] && imus=(off on)
+  local imus=()
+  for imu in ${HELDOUT_IMU:-off on}; do
+    [[ "$imu" == off || -f "$seq/imu.csv" ]] && imus+=("$imu")
+  done
   for mode in ${HELDOUT_MODES:-gradient epic epic+validation}; do
     for imu in "${imus[@]}"; do
       local dir="$out/track/$scenario-$seed/$mode-imu-$imu"
@@ -103,9 +107,10 @@ while (($#)); do
     --scenarios) scenarios="$2"; shift 2 ;;
     --frames) frames="$2"; shift 2 ;;
     --modes) export HELDOUT_MODES="$2"; shift 2 ;;
+    --imu) export HELDOUT_IMU="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "heldout: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done

@@ -80,7 +80,9 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                          {"vision_unchecked", s.predictor.vision_unchecked},
                          {"unaided_down_updates", s.predictor.unaided_down_updates},
                          {"unaided_tilt_contradictions", s.predictor.unaided_tilt_contradictions},
-                         {"unaided_position_holds", s.predictor.unaided_position_holds}}}};
+                         {"unaided_position_holds", s.predictor.unaided_position_holds},
+                         {"unaided_pose_floors", s.predictor.unaided_pose_floors},
+                         {"resumption_resets", s.predictor.resumption_resets}}}};
 }
 
 }  // namespace epichead::tools

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "epichead/fusion/unaided_update.h"
+#include "epichead/geometry/pose_covariance.h"
 
 namespace epichead::fusion {
 namespace {
@@ -179,6 +180,12 @@ void Predictor::update_unaided(double t_s) {
   StateEntry* e = imu_.newest_sample_state();
   if (!e) return;
   PredictorCounters& c = status_.counters;
+  if (!unaided_floored_) {
+    // Going unaided: the pose is known no better than the last vision pose said (unaided_update.h).
+    unaided_floored_ = true;
+    const Matrix6d J = geometry::filter_pose_error_jacobian(e->x.obj_R_cam);
+    c.unaided_pose_floors += floor_pose_covariance(e->P, J * last_vision_cov_ * J.transpose());
+  }
   if (gravity_.learnt() && t_s >= next_down_t_s_) {
     // A window too short (after a gap) or a camera accelerating: tried again a tenth of the period
     // later, not at every sample (each try turns up to window_s of samples: ~20 us).
@@ -205,6 +212,34 @@ void Predictor::update_unaided(double t_s) {
   }
 }
 
+VisionResult Predictor::initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
+  PoseFilter& f = filter();
+  PredictorCounters& c = status_.counters;
+  // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
+  // about to be replaced, may be the one that is wrong).
+  if (check_tilt(t_s, cam_T_obj)) return {VisionVerdict::AgainstGravity, 0};
+  // After a run of gated poses, one that cannot be checked (the accelerometer's window is cut by
+  // a gap) may be the wrong lock the gap caused: the filter waits for one that can be.
+  if (initialised_ && options_.mode == PredictorMode::ImuAided && gravity_.learnt() && !measured_down_cam(t_s)) {
+    ++c.vision_unchecked;
+    return {VisionVerdict::Unchecked, 0};
+  }
+  if (!f.initialise(t_s, cam_T_obj, cov)) {
+    ++c.vision_no_imu;
+    return {VisionVerdict::NoImu, 0};
+  }
+  if (c.vision_initialised > 0) ++c.reinitialisations;
+  ++c.vision_initialised;
+  initialised_ = true;
+  reinit_pending_ = false;
+  status_.gated_in_a_row = 0;
+  applied_in_a_row_ = 0;
+  status_.last_update_t_s = t_s;
+  note_vision_cov(cov);
+  note_hold(t_s, cam_T_obj);
+  return {VisionVerdict::Initialised, 0};
+}
+
 VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov_in) {
   PredictorCounters& c = status_.counters;
   const StateHistory& history = imu_.history();
@@ -217,30 +252,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   }
   const Matrix6d cov = 0.5 * (cov_in + cov_in.transpose());
   PoseFilter& f = filter();
-  if (!initialised_ || reinit_pending_) {
-    // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
-    // about to be replaced, may be the one that is wrong).
-    if (check_tilt(t_s, cam_T_obj)) return {VisionVerdict::AgainstGravity, 0};
-    // After a run of gated poses, one that cannot be checked (the accelerometer's window is cut by
-    // a gap) may be the wrong lock the gap caused: the filter waits for one that can be.
-    if (initialised_ && options_.mode == PredictorMode::ImuAided && gravity_.learnt() && !measured_down_cam(t_s)) {
-      ++c.vision_unchecked;
-      return {VisionVerdict::Unchecked, 0};
-    }
-    if (!f.initialise(t_s, cam_T_obj, cov)) {
-      ++c.vision_no_imu;
-      return {VisionVerdict::NoImu, 0};
-    }
-    if (c.vision_initialised > 0) ++c.reinitialisations;
-    ++c.vision_initialised;
-    initialised_ = true;
-    reinit_pending_ = false;
-    status_.gated_in_a_row = 0;
-    applied_in_a_row_ = 0;
-    status_.last_update_t_s = t_s;
-    note_hold(t_s, cam_T_obj);
-    return {VisionVerdict::Initialised, 0};
-  }
+  if (!initialised_ || reinit_pending_) return initialise_from(t_s, cam_T_obj, cov);
   // Poses come in exposure order; one older than the last applied would undo it on re-propagation.
   if (t_s <= f.update_t_s()) {
     ++c.vision_out_of_order;
@@ -254,6 +266,21 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   if (!r->applied) {
     ++c.vision_gated;
     applied_in_a_row_ = 0;
+    if (resumes_after_gap(t_s, cam_T_obj)) {
+      // Back after a stretch without vision, the state drifted further than its covariance says
+      // (a step's burst integrated from a velocity the frames had not pinned down: docs/fusion.md,
+      // "Without vision"). Re-initialised from this pose now, as PX4's EKF2 resets to an aiding
+      // source that returns after a timeout, rather than after reinit_after_gated frames tracked
+      // from the drifted prediction, which lead the tracker off too. The sensor's biases and the
+      // gravity direction are kept; the velocity starts again from zero.
+      carry_sensor_state();
+      const VisionResult re = initialise_from(t_s, cam_T_obj, cov);
+      if (re.verdict == VisionVerdict::Initialised) {
+        ++c.resumption_resets;
+        return re;
+      }
+      imu_.drop_carried_motion();
+    }
     if (++status_.gated_in_a_row >= options_.reinit_after_gated) reinit_pending_ = true;
     return {VisionVerdict::Gated, r->mahalanobis2};
   }
@@ -262,6 +289,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   status_.last_nis = r->mahalanobis2;
   status_.last_update_t_s = t_s;
   ++applied_in_a_row_;
+  note_vision_cov(cov);
   note_hold(t_s, cam_T_obj);
   if (options_.mode == PredictorMode::ImuAided)
     if (const StateEntry* e = imu_.newest_state()) {
@@ -269,6 +297,31 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
       gravity_.learn(t_s, e->x.gravity_obj_mps2(), sigma, e->x.gyro_bias_radps, e->x.accel_bias_mps2, applied_in_a_row_);
     }
   return {VisionVerdict::Applied, r->mahalanobis2};
+}
+
+bool Predictor::resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const {
+  if (options_.mode != PredictorMode::ImuAided || !options_.unaided.enabled || !have_hold_) return false;
+  if (!(t_s - status_.last_update_t_s > options_.unaided.after_s)) return false;
+  // Only where the unaided filter's position hold allows the camera to be.
+  const Eigen::Vector3d obj_p_cam = cam_T_obj.inverse().translation();
+  return (obj_p_cam - hold_obj_p_cam_).norm() <= options_.unaided.position_sigma_m;
+}
+
+void Predictor::carry_sensor_state() {
+  const StateEntry* e = imu_.newest_state();
+  if (!e) return;
+  NavState motion = e->x;
+  motion.obj_v_cam.setZero();
+  ErrorCovariance P = e->P;
+  P.middleRows<3>(err::v).setZero();
+  P.middleCols<3>(err::v).setZero();
+  P.diagonal().segment<3>(err::v).setConstant(options_.initial_speed_mps * options_.initial_speed_mps);
+  imu_.carry_motion(motion, P);
+}
+
+void Predictor::note_vision_cov(const Matrix6d& cov) {
+  last_vision_cov_ = cov;
+  unaided_floored_ = false;
 }
 
 void Predictor::note_hold(double t_s, const Eigen::Isometry3d& cam_T_obj) {

@@ -1,5 +1,6 @@
 #include "epichead/fusion/unaided_update.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 
@@ -58,6 +59,16 @@ bool hold_position(NavState& x, ErrorCovariance& P, const Eigen::Vector3d& obj_p
   detail::kalman_update<err::dim, 3>(P, H, r, Rm, std::numeric_limits<double>::infinity(), dx, applied);
   if (applied) inject(x, dx);
   return applied;
+}
+
+bool floor_pose_covariance(ErrorCovariance& P, const Eigen::Matrix<double, 6, 6>& floor) {
+  if (!floor.allFinite()) return false;
+  const Eigen::Matrix<double, 6, 6> d = 0.5 * (floor + floor.transpose()) - P.topLeftCorner<6, 6>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(d);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues().maxCoeff() > 0)) return false;
+  const Eigen::Matrix<double, 6, 1> raise = eig.eigenvalues().cwiseMax(0.0);
+  P.topLeftCorner<6, 6>() += eig.eigenvectors() * raise.asDiagonal() * eig.eigenvectors().transpose();
+  return true;
 }
 
 }  // namespace epichead::fusion

@@ -34,7 +34,9 @@ py::dict counters_dict(const PredictorCounters& c) {
                   py::arg("gravity_forgotten") = c.gravity_forgotten, py::arg("vision_unchecked") = c.vision_unchecked,
                   py::arg("unaided_down_updates") = c.unaided_down_updates,
                   py::arg("unaided_tilt_contradictions") = c.unaided_tilt_contradictions,
-                  py::arg("unaided_position_holds") = c.unaided_position_holds, py::arg("reinitialisations") = c.reinitialisations,
+                  py::arg("unaided_position_holds") = c.unaided_position_holds,
+                  py::arg("unaided_pose_floors") = c.unaided_pose_floors, py::arg("resumption_resets") = c.resumption_resets,
+                  py::arg("reinitialisations") = c.reinitialisations,
                   py::arg("repropagated_samples") = c.repropagated_samples);
 }
 

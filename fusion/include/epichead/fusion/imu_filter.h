@@ -39,6 +39,7 @@ class ImuFilter final : public PoseFilter {
   void clear() { history_.clear(); }
   // The next initialisation takes velocity, biases and gravity (with their covariance) from here.
   void carry_motion(const NavState& motion, const ErrorCovariance& covariance);
+  void drop_carried_motion() { carry_pending_ = false; }
 
   const StateHistory& history() const { return history_; }
   // The newest state (sample or anchor); null before initialisation.

@@ -78,6 +78,8 @@ struct PredictorCounters {
   std::uint64_t unaided_down_updates = 0;    // tilt updates from the accelerometer without vision
   std::uint64_t unaided_tilt_contradictions = 0;  // of those, the filter's own tilt contradicted gravity
   std::uint64_t unaided_position_holds = 0;  // position held near the last verified one without vision
+  std::uint64_t unaided_pose_floors = 0;     // pose covariance raised to the last vision pose's on going unaided
+  std::uint64_t resumption_resets = 0;       // re-initialisations from a gated pose after a gap (of reinitialisations)
   std::uint64_t reinitialisations = 0;  // initialisations after the first (reset or gated run)
   std::uint64_t repropagated_samples = 0;
 };
@@ -143,6 +145,17 @@ class Predictor {
   // update) becomes the one the unaided filter is held near, unless the accelerometer could not
   // check the pose's tilt or contradicted it.
   void note_hold(double t_s, const Eigen::Isometry3d& cam_T_obj);
+  // The first pose, or the first after reset / a run of gated poses / a gap (never from a tilted
+  // lock: the learnt down decides).
+  VisionResult initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
+  // A gated pose at t_s that comes after more than unaided.after_s without an applied one, within
+  // unaided.position_sigma_m of the held position: re-initialise from it (ImuAided only).
+  bool resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const;
+  // The newest state's biases and gravity direction (with their covariance) for the next
+  // initialisation; its velocity is forgotten (zero, initial_speed_mps).
+  void carry_sensor_state();
+  // After an applied or initialising pose: its covariance, for the unaided pose floor.
+  void note_vision_cov(const Matrix6d& cov);
   // The filter of options_.mode.
   PoseFilter& filter();
   const PoseFilter& filter() const;
@@ -161,6 +174,10 @@ class Predictor {
   // (or any, before a down is learnt): where the unaided filter is held.
   bool have_hold_ = false;
   Eigen::Vector3d hold_obj_p_cam_ = Eigen::Vector3d::Zero();
+  // The last applied or initialising pose's covariance (vision's order): the floor of the
+  // filter's pose covariance once it goes unaided (floor_pose_covariance), taken once per stretch.
+  Matrix6d last_vision_cov_ = Matrix6d::Zero();
+  bool unaided_floored_ = true;
   PredictorStatus status_;
 };
 

@@ -33,4 +33,12 @@ DownUpdateResult update_down(NavState& x, ErrorCovariance& P, const Eigen::Vecto
 // not a measurement that would make it confident. True when applied.
 bool hold_position(NavState& x, ErrorCovariance& P, const Eigen::Vector3d& obj_p_cam, double sigma_m);
 
+// The pose block (orientation, position) of P raised to at least `floor` (6x6, the filters' pose
+// error order, symmetric positive semi-definite): the positive part of floor - P_pose is added, so
+// P stays positive semi-definite and its cross-covariances are kept. For a filter going unaided:
+// successive vision poses share most of their error (the same edges, seen from nearly the same
+// place), so their updates did not average it out, and the filter's pose is known no better than
+// one vision pose said (docs/fusion.md, "Without vision"). True when P was raised.
+bool floor_pose_covariance(ErrorCovariance& P, const Eigen::Matrix<double, 6, 6>& floor);
+
 }  // namespace epichead::fusion
