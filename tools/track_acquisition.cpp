@@ -5,10 +5,20 @@
 #include <cmath>
 
 namespace epichead::tools {
+namespace {
+
+// --no-reacquire keeps the detected start's rechecks but starts none of its own after a degraded frame.
+RecheckOptions recheck_options(const AcquisitionOptions& o) {
+  RecheckOptions r = o.recheck;
+  r.after_degraded = r.after_degraded && o.reacquire;
+  return r;
+}
+
+}  // namespace
 
 TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
                                    const AcquisitionOptions& options)
-    : seq_(&seq), tracking_(tracking), options_(options) {
+    : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)) {
   if (auto up = object_up(options.detection); up) up_obj_ = *up;
 }
 
@@ -46,7 +56,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   auto r = detect(frame, t_s, std::nullopt);
   if (r && *r) {
     start_frame_ = frame_number;
-    provisional_from(t_s);
+    rechecks_due_.found_at(t_s);
   }
   return r;
 }
@@ -76,7 +86,8 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   auto r = detect(frame, t_s, near, {}, upright);
   if (r && *r) {
     ++reacquired_;
-    provisional_from(t_s);
+    rechecks_due_.found_at(t_s);
+    orient_ref_.reset();
     frames_to_reacquire_.push_back(lost_run_);
     lost_run_ = 0;
     in_loss_ = false;
@@ -84,23 +95,20 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   return r;
 }
 
-bool TrackAcquisition::recheck_due(double t_s) const {
-  return options_.provisional_s > 0 && t_s <= provisional_until_s_ && t_s >= next_recheck_s_;
-}
-
 std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::recheck(const cv::Mat& frame, double t_s,
-                                                                                       const Eigen::Isometry3d& tracked) {
-  next_recheck_s_ = t_s + options_.recheck_interval_s;
+                                                                                       const Eigen::Isometry3d& tracked,
+                                                                                       const Eigen::Isometry3d& orient_like) {
   ++rechecks_;
-  // The whole search; of the poses that draw the same outline, the one turned as the tracked pose is.
-  auto found = detect(frame, t_s, std::nullopt, tracked);
+  // The whole search; of the poses that draw the same outline, the one turned as orient_like is.
+  auto found = detect(frame, t_s, std::nullopt, orient_like);
   if (!found) return found;
   const auto now = detector_->verify(frame, tracked);
   if (!now) return std::unexpected(now.error());
   recheck_log_.push_back({{"t_s", t_s}, {"found", found->has_value()}, {"found_score", last_score_}, {"tracked_score", now->score}});
   if (!*found || last_score_ < options_.switch_ratio * now->score) return std::optional<Eigen::Isometry3d>{};
   ++switches_;
-  provisional_from(t_s);
+  rechecks_due_.found_at(t_s);
+  orient_ref_.reset();
   return found;
 }
 
@@ -113,11 +121,21 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
     auto again = find_again(frame, t_s, predicted, predictor.upright(t_s));
     if (!again) return std::unexpected(again.error());
     found = *again;
-  } else if (report.status != vision::TrackStatus::Lost && recheck_due(t_s)) {
-    auto better = recheck(frame, t_s, report.cam_T_obj);
-    if (!better) return std::unexpected(better.error());
-    found = *better;
+  } else {
+    const int degraded_stretches = rechecks_due_.started_after_degraded();
+    const bool due = rechecks_due_.due_after(report.status, t_s);
+    // A stretch a degraded frame started: the tracked pose may be a wrong lock turned well away,
+    // and of a symmetric model's outlines the one nearest it may be a twin of the object's. The
+    // last pose tracked before it is the one to turn like (with the detected start's, the
+    // tracked pose itself).
+    if (rechecks_due_.started_after_degraded() != degraded_stretches) orient_ref_ = last_tracked_;
+    if (due) {
+      auto better = recheck(frame, t_s, report.cam_T_obj, orient_ref_ ? *orient_ref_ : report.cam_T_obj);
+      if (!better) return std::unexpected(better.error());
+      found = *better;
+    }
   }
+  if (report.status == vision::TrackStatus::Tracked) last_tracked_ = found ? *found : report.cam_T_obj;
   if (!found) return {};
   tracker.reset();
   predictor.restart(t_s, *found);
@@ -136,6 +154,7 @@ nlohmann::json TrackAcquisition::to_json() const {
                       {"frames_to_reacquire", frames_to_reacquire_},
                       {"detections", detections_},
                       {"rechecks", rechecks_},
+                      {"rechecks_after_degraded", rechecks_due_.started_after_degraded()},
                       {"switches", switches_},
                       {"recheck_log", recheck_log_},
                       {"detect_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},

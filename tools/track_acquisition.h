@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "detection_setup.h"
+#include "recheck_schedule.h"
 #include "track_prediction.h"
 #include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
@@ -26,12 +27,12 @@ struct AcquisitionOptions {
   bool use_imu_gravity = false;      // gravity from imu.csv narrows the search (with --object-up)
   bool reacquire = true;             // detect after a loss (false: retry from the last pose only)
   int lost_frames_before_detection = 3;
-  // A pose found by detection is provisional for this long: every recheck_interval_s the whole
-  // search runs again, and a pose that explains a much longer outline than the tracked one
-  // (score at least switch_ratio times) takes over. Clutter can hold a box-like outline (a
-  // printed rectangle) before the object itself comes into view (late_entry).
-  double provisional_s = 3.0;
-  double recheck_interval_s = 0.5;
+  // While a pose is provisional (recheck_schedule.h: found by detection, or after a degraded
+  // frame) the whole search runs again every so often, and a pose that explains a much longer
+  // outline than the tracked one (score at least switch_ratio times) takes over. Clutter can hold
+  // a box-like outline (a printed rectangle) before the object itself comes into view
+  // (late_entry).
+  RecheckOptions recheck;
   double switch_ratio = 1.5;
 };
 
@@ -56,18 +57,15 @@ class TrackAcquisition {
   std::expected<void, std::string> after_tracking(const cv::Mat& frame, const vision::WindowImage& image, double t_s,
                                                   const Eigen::Isometry3d& predicted, vision::ModelTracker& tracker,
                                                   TrackPredictor& predictor, vision::FrameReport& report);
-  // While a detected start is provisional and a recheck is due at t_s: the whole search on
-  // this frame, and the pose to switch to when it explains a much longer outline than `tracked`.
-  bool recheck_due(double t_s) const;
+  // A recheck (the schedule said so): the whole search on this frame, and the pose to switch to
+  // when it explains a much longer outline than `tracked`.
+  // Of the poses that draw the same outline, the one turned as `orient_like` is taken.
   std::expected<std::optional<Eigen::Isometry3d>, std::string> recheck(const cv::Mat& frame, double t_s,
-                                                                       const Eigen::Isometry3d& tracked);
+                                                                       const Eigen::Isometry3d& tracked,
+                                                                       const Eigen::Isometry3d& orient_like);
   nlohmann::json to_json() const;
 
  private:
-  void provisional_from(double t_s) {
-    provisional_until_s_ = t_s + options_.provisional_s;
-    next_recheck_s_ = t_s + options_.recheck_interval_s;
-  }
   std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
                                                                       const std::optional<Eigen::Isometry3d>& near,
                                                                       const std::optional<Eigen::Isometry3d>& orient_like = {},
@@ -80,7 +78,9 @@ class TrackAcquisition {
   int start_frame_ = -1, start_attempts_ = 0;
   int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
   bool in_loss_ = false;
-  double provisional_until_s_ = -1, next_recheck_s_ = 0;
+  RecheckSchedule rechecks_due_;
+  std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
+  std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a degraded frame started
   int rechecks_ = 0, switches_ = 0;
   double last_score_ = 0;
   nlohmann::json recheck_log_ = nlohmann::json::array();  // of the last detection's best hypothesis

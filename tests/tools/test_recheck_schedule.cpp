@@ -1,0 +1,55 @@
+// When `epichead track` reruns detection on a frame it tracks (tools/recheck_schedule.h): for a
+// while after a detected start or a degraded frame, every interval; a degraded frame's first
+// recheck is on that frame; lost frames never, and nothing when turned off.
+#include <catch2/catch.hpp>
+
+#include "recheck_schedule.h"
+
+using epichead::tools::RecheckOptions;
+using epichead::tools::RecheckSchedule;
+using epichead::vision::TrackStatus;
+
+namespace {
+
+// The frames (at 30 Hz from t0_s for n frames, all with `status`) on which a recheck is due.
+std::vector<int> due_frames(RecheckSchedule& s, TrackStatus status, double t0_s, int n) {
+  std::vector<int> due;
+  for (int i = 0; i < n; ++i)
+    if (s.due_after(status, t0_s + i / 30.0)) due.push_back(i);
+  return due;
+}
+
+}  // namespace
+
+TEST_CASE("recheck schedule: a detected start is rechecked every half second for three seconds") {
+  RecheckSchedule s;
+  CHECK(due_frames(s, TrackStatus::Tracked, 0.0, 30).empty());  // nothing found yet
+  s.found_at(1.0);
+  CHECK(due_frames(s, TrackStatus::Tracked, 1.0, 120) == std::vector<int>{15, 30, 45, 60, 75, 90});
+  CHECK(s.started_after_degraded() == 0);
+}
+
+TEST_CASE("recheck schedule: a degraded frame is rechecked at once and then as a detected start; lost frames never") {
+  RecheckSchedule s;
+  CHECK(s.due_after(TrackStatus::Degraded, 2.0));
+  CHECK(s.started_after_degraded() == 1);
+  CHECK_FALSE(s.due_after(TrackStatus::Degraded, 2.1));  // inside the stretch: no new start
+  CHECK(s.started_after_degraded() == 1);
+  CHECK_FALSE(s.due_after(TrackStatus::Lost, 2.5));
+  CHECK(s.due_after(TrackStatus::Tracked, 2.51));
+  CHECK(due_frames(s, TrackStatus::Tracked, 5.1, 60).empty());  // the stretch ended at 5 s
+  CHECK(s.due_after(TrackStatus::Degraded, 6.0));  // a new one
+  CHECK(s.started_after_degraded() == 2);
+}
+
+TEST_CASE("recheck schedule: off after degraded frames, or with no provisional time, nothing is due") {
+  RecheckOptions no_degraded;
+  no_degraded.after_degraded = false;
+  RecheckSchedule a(no_degraded);
+  CHECK(due_frames(a, TrackStatus::Degraded, 0.0, 90).empty());
+  RecheckOptions none;
+  none.provisional_s = 0;
+  RecheckSchedule b(none);
+  b.found_at(0.0);
+  CHECK(due_frames(b, TrackStatus::Degraded, 0.0, 90).empty());
+}

@@ -1,0 +1,53 @@
+#pragma once
+// When `epichead track` runs the whole detection search on a frame it is tracking, to catch a
+// wrong lock (tools/track_acquisition.h). A pose is provisional for provisional_s after it was
+// found by detection, or after a degraded frame: every recheck_interval_s meanwhile the search
+// runs again, and the caller switches to what it finds when that explains a much longer outline.
+// A degraded frame's first recheck is on that frame. No detection here: only the times.
+#include <cmath>
+
+#include "epichead/vision/model_tracker.h"
+
+namespace epichead::tools {
+
+struct RecheckOptions {
+  double provisional_s = 3.0;        // <= 0: no rechecks at all
+  double recheck_interval_s = 0.5;
+  // Without the IMU, a burst the constant-velocity prediction cannot follow leaves the tracker on
+  // a wrong lock that it then reports as tracked; the degraded frames on the way there are the
+  // only sign, and detection the only thing that tells the lock from the object.
+  bool after_degraded = true;
+};
+
+class RecheckSchedule {
+ public:
+  explicit RecheckSchedule(const RecheckOptions& options = {}) : options_(options) {}
+
+  // A pose found by detection at t_s: provisional from now, first recheck an interval later.
+  void found_at(double t_s) {
+    provisional_until_s_ = t_s + options_.provisional_s;
+    next_s_ = t_s + options_.recheck_interval_s;
+  }
+  // After the tracker's frame at t_s: whether the search runs on it. A degraded frame outside a
+  // provisional stretch starts one, with its first recheck on this frame; a lost frame never
+  // rechecks (re-acquisition handles it).
+  bool due_after(vision::TrackStatus status, double t_s) {
+    if (status == vision::TrackStatus::Lost || !(options_.provisional_s > 0)) return false;
+    if (status == vision::TrackStatus::Degraded && options_.after_degraded && !(t_s <= provisional_until_s_)) {
+      ++after_degraded_;
+      provisional_until_s_ = t_s + options_.provisional_s;
+      next_s_ = t_s;
+    }
+    if (!(t_s <= provisional_until_s_ && t_s >= next_s_)) return false;
+    next_s_ = t_s + options_.recheck_interval_s;
+    return true;
+  }
+  int started_after_degraded() const { return after_degraded_; }
+
+ private:
+  RecheckOptions options_;
+  double provisional_until_s_ = -INFINITY, next_s_ = 0;
+  int after_degraded_ = 0;
+};
+
+}  // namespace epichead::tools
