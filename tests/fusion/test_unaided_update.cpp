@@ -224,7 +224,7 @@ TEST_CASE("floor_pose_covariance: the pose block is raised to the floor where it
   CHECK(f.P == raised);
 }
 
-TEST_CASE("Predictor back after a gap: a pose the drifted filter gates re-initialises it at once, the biases kept; with the unaided updates off it is gated") {
+TEST_CASE("Predictor back after a gap: a pose the drifted filter gates re-initialises it at once with the biases kept, and with the unaided updates off it is gated") {
   for (const bool enabled : {true, false}) {
     INFO("unaided updates " << (enabled ? "on" : "off"));
     PredictorOptions options;

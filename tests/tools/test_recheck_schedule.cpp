@@ -29,7 +29,7 @@ TEST_CASE("recheck schedule: a detected start is rechecked every half second for
   CHECK(s.started_after_degraded() == 0);
 }
 
-TEST_CASE("recheck schedule: a degraded frame is rechecked at once and then as a detected start; lost frames never") {
+TEST_CASE("recheck schedule: a degraded frame is rechecked at once and then as a detected start, lost frames never") {
   RecheckSchedule s;
   CHECK(s.due_after(TrackStatus::Degraded, 2.0));
   CHECK(s.started_after_degraded() == 1);
