@@ -244,6 +244,8 @@ class ImuPredictor final : public TrackPredictor {
             {"vision_gated", c.vision_gated},
             {"vision_too_old", c.vision_too_old},
             {"reinitialisations", c.reinitialisations},
+            {"resumption_resets", c.resumption_resets},
+            {"unaided_pose_floors", c.unaided_pose_floors},
             {"gravity_learnt", st.gravity_learnt},
             {"vision_against_gravity", c.vision_against_gravity},
             {"gravity_forgotten", c.gravity_forgotten},
