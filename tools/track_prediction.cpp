@@ -247,6 +247,7 @@ class ImuPredictor final : public TrackPredictor {
             {"resumption_resets", c.resumption_resets},
             {"unaided_pose_floors", c.unaided_pose_floors},
             {"gravity_learnt", st.gravity_learnt},
+            {"learnt_down_obj", learnt_down_json()},
             {"vision_against_gravity", c.vision_against_gravity},
             {"gravity_forgotten", c.gravity_forgotten},
             {"resets_after_loss", resets_},
@@ -268,6 +269,12 @@ class ImuPredictor final : public TrackPredictor {
   static bool strongly_supported(const vision::FrameReport& r) {
     const int found = r.found + 2 * r.ellipses_found, kept = r.inliers + 2 * r.ellipses_found;
     return r.status == vision::TrackStatus::Tracked && kept >= 6 && kept >= 0.8 * found;
+  }
+  // The object's down the predictor learnt (unit, object frame), or null.
+  nlohmann::json learnt_down_json() const {
+    const auto d = predictor_.learnt_down_obj();
+    if (!d) return nullptr;
+    return nlohmann::json::array({d->x(), d->y(), d->z()});
   }
   static constexpr double kLostResetS = 1.0;
   static constexpr int kSupportedGatedRestart = 3;
