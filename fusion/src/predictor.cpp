@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "epichead/fusion/unaided_update.h"
 #include "epichead/geometry/pose_covariance.h"
@@ -253,8 +252,6 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   }
   const Matrix6d cov = 0.5 * (cov_in + cov_in.transpose());
   PoseFilter& f = filter();
-  const double since_offered_s = t_s - last_offered_t_s_;
-  last_offered_t_s_ = t_s;
   if (!initialised_ || reinit_pending_) return initialise_from(t_s, cam_T_obj, cov);
   // Poses come in exposure order; one older than the last applied would undo it on re-propagation.
   if (t_s <= f.update_t_s()) {
@@ -269,9 +266,9 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   if (!r->applied) {
     ++c.vision_gated;
     applied_in_a_row_ = 0;
-    if (resumes_after_gap(since_offered_s, cam_T_obj)) {
-      // Back after a stretch without vision (no pose offered: a camera stall, a loss; a run of
-      // gated poses is reinit_after_gated's), the state drifted further than its covariance says
+    if (resumes_after_gap(t_s, cam_T_obj)) {
+      // Back after a stretch without an applied pose (a camera stall, lost and gated frames), the
+      // state drifted further than its covariance says
       // (a step's burst integrated from a velocity the frames had not pinned down: docs/fusion.md,
       // "Without vision"). Re-initialised from this pose now, as PX4's EKF2 resets to an aiding
       // source that returns after a timeout, rather than after reinit_after_gated frames tracked
@@ -303,9 +300,10 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
   return {VisionVerdict::Applied, r->mahalanobis2};
 }
 
-bool Predictor::resumes_after_gap(double since_offered_s, const Eigen::Isometry3d& cam_T_obj) const {
+bool Predictor::resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const {
   if (options_.mode != PredictorMode::ImuAided || !options_.unaided.enabled || !have_hold_) return false;
-  if (!(since_offered_s > options_.unaided.after_s)) return false;
+  // As PX4's EKF2 times out an aiding source: from the last measurement fused, not offered.
+  if (!(t_s - status_.last_update_t_s > options_.unaided.after_s)) return false;
   // Only where the unaided filter's position hold allows the camera to be.
   const Eigen::Vector3d obj_p_cam = cam_T_obj.inverse().translation();
   return (obj_p_cam - hold_obj_p_cam_).norm() <= options_.unaided.position_sigma_m;
@@ -415,7 +413,6 @@ void Predictor::carry_motion(const NavState& motion, const ErrorCovariance& cova
 
 void Predictor::reset() {
   initialised_ = false;
-  last_offered_t_s_ = -std::numeric_limits<double>::infinity();
   reinit_pending_ = false;
   filter().reset();
   status_.gated_in_a_row = 0;

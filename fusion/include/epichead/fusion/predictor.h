@@ -9,7 +9,6 @@
 // Nothing allocates after construction.
 #include <cstdint>
 #include <expected>
-#include <limits>
 #include <optional>
 #include <string>
 
@@ -149,9 +148,9 @@ class Predictor {
   // The first pose, or the first after reset / a run of gated poses / a gap (never from a tilted
   // lock: the learnt down decides).
   VisionResult initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
-  // A gated pose that comes more than unaided.after_s after the pose offered before it, within
+  // A gated pose at t_s more than unaided.after_s after the last applied one, within
   // unaided.position_sigma_m of the held position: re-initialise from it (ImuAided only).
-  bool resumes_after_gap(double since_offered_s, const Eigen::Isometry3d& cam_T_obj) const;
+  bool resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const;
   // The newest state's biases and gravity direction (with their covariance) for the next
   // initialisation; its velocity is forgotten (zero, initial_speed_mps).
   void carry_sensor_state();
@@ -178,7 +177,6 @@ class Predictor {
   // The last applied or initialising pose's covariance (vision's order): the floor of the
   // filter's pose covariance once it goes unaided (floor_pose_covariance), taken once per stretch.
   Matrix6d last_vision_cov_ = Matrix6d::Zero();
-  double last_offered_t_s_ = -std::numeric_limits<double>::infinity();  // the last add_vision with a usable pose
   bool unaided_floored_ = true;
   PredictorStatus status_;
 };
