@@ -268,12 +268,12 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
     applied_in_a_row_ = 0;
     if (resumes_after_gap(t_s, cam_T_obj)) {
       // Back after a stretch without an applied pose (a camera stall, lost and gated frames), the
-      // state drifted further than its covariance says
-      // (a step's burst integrated from a velocity the frames had not pinned down: docs/fusion.md,
-      // "Without vision"). Re-initialised from this pose now, as PX4's EKF2 resets to an aiding
-      // source that returns after a timeout, rather than after reinit_after_gated frames tracked
-      // from the drifted prediction, which lead the tracker off too. The sensor's biases and the
-      // gravity direction are kept; the velocity starts again from zero.
+      // state drifted further than its covariance says (a step's burst integrated from a velocity
+      // the frames had not pinned down: docs/fusion.md, "Without vision"). Re-initialised from
+      // this pose now, as PX4's EKF2 resets to an aiding source whose fusion timed out, rather
+      // than after reinit_after_gated frames tracked from the drifted prediction, which lead the
+      // tracker off too. The sensor's biases and the gravity direction are kept; the velocity
+      // starts again from zero.
       carry_sensor_state();
       const VisionResult re = initialise_from(t_s, cam_T_obj, cov);
       if (re.verdict == VisionVerdict::Initialised) {
