@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "level_to_gravity.h"
+
 namespace epichead::tools {
 namespace {
 
@@ -19,6 +21,8 @@ RecheckOptions recheck_options(const AcquisitionOptions& o) {
 TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
                                    const AcquisitionOptions& options)
     : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)) {
+  for (const auto& v : seq.model().vertices) centre_obj_ += v;
+  if (!seq.model().vertices.empty()) centre_obj_ /= static_cast<double>(seq.model().vertices.size());
   if (auto up = object_up(options.detection); up) up_obj_ = *up;
 }
 
@@ -137,6 +141,11 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   }
   if (report.status == vision::TrackStatus::Tracked) last_tracked_ = found ? *found : report.cam_T_obj;
   if (!found) return {};
+  // With the IMU and the object's down learnt, the tilt is gravity's, not the outline's.
+  if (const auto up = predictor.upright(t_s)) {
+    found = level_to_gravity(*found, *up, centre_obj_);
+    ++levelled_;
+  }
   tracker.reset();
   predictor.restart(t_s, *found);
   tracker.track(image, *found, report);
@@ -155,6 +164,7 @@ nlohmann::json TrackAcquisition::to_json() const {
                       {"detections", detections_},
                       {"rechecks", rechecks_},
                       {"rechecks_after_degraded", rechecks_due_.started_after_degraded()},
+                      {"levelled_to_gravity", levelled_},
                       {"switches", switches_},
                       {"recheck_log", recheck_log_},
                       {"detect_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},
