@@ -39,6 +39,7 @@
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/scene_library.h"
 #include "epichead/sim/sim_world.h"
+#include "epichead/vision/model_centre.h"
 #include "epichead/vision/model_symmetry.h"
 #include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/visibility.h"
@@ -135,10 +136,7 @@ bool write_overlay(const head::TrackedFrame& f, const vision::CadModel& model, c
 class TruthMeter {
  public:
   TruthMeter(sim::SimWorld& world, const vision::CadModel& model, const SimRunArgs& a, RunMeasures& m)
-      : w_(world), a_(a), m_(m), cam_(world.camera_model()) {
-    for (const auto& v : model.vertices) centre_obj_ += v;
-    if (!model.vertices.empty()) centre_obj_ /= static_cast<double>(model.vertices.size());
-  }
+      : w_(world), a_(a), m_(m), cam_(world.camera_model()), centre_obj_(vision::model_centre(model)) {}
   std::expected<void, std::string> open_timeline(const std::string& path) {
     timeline_.open(path);
     if (!timeline_) return std::unexpected("cannot write " + path);
@@ -205,7 +203,7 @@ class TruthMeter {
   const SimRunArgs& a_;
   RunMeasures& m_;
   vision::Camera cam_;
-  Eigen::Vector3d centre_obj_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre_obj_;
   std::ofstream timeline_;
   double sq_xy_ = 0, sq_all_ = 0, sq_centre_ = 0;
   long samples_ = 0, centre_n_ = 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "level_to_gravity.h"
+#include "epichead/vision/model_centre.h"
 
 namespace epichead::tools {
 namespace {
@@ -20,9 +21,8 @@ RecheckOptions recheck_options(const AcquisitionOptions& o) {
 
 TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
                                    const AcquisitionOptions& options)
-    : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)) {
-  for (const auto& v : seq.model().vertices) centre_obj_ += v;
-  if (!seq.model().vertices.empty()) centre_obj_ /= static_cast<double>(seq.model().vertices.size());
+    : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)),
+      centre_obj_(vision::model_centre(seq.model())) {
   if (auto up = object_up(options.detection); up) up_obj_ = *up;
 }
 

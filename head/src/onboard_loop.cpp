@@ -13,6 +13,7 @@
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
+#include "epichead/vision/model_centre.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
 #include "realtime.h"
@@ -37,13 +38,6 @@ double wall_ms_since(WallClock::time_point t0) {
   return std::chrono::duration<double, std::milli>(WallClock::now() - t0).count();
 }
 
-// The centre of the model's vertices: what fixation keeps in the middle of the image.
-Eigen::Vector3d model_centre(const vision::CadModel& model) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const auto& v : model.vertices) sum += v;
-  return model.vertices.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(model.vertices.size()));
-}
-
 }  // namespace
 
 struct OnboardLoop::Impl {
@@ -51,7 +45,7 @@ struct OnboardLoop::Impl {
        fusion::Predictor pred, HeadController ctrl, std::unique_ptr<Recorder> rec)
       : model(&m), camera(cam), options(o), ports(p),
         vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
-        controller(std::move(ctrl)), target_point_obj(model_centre(m)), imu_clock(clock_sync_options(o)),
+        controller(std::move(ctrl)), target_point_obj(vision::model_centre(m)), imu_clock(clock_sync_options(o)),
         recorder(std::move(rec)) {}
 
   const vision::CadModel* model;

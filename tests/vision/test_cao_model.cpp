@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "epichead/vision/cao_model.h"
+#include "epichead/vision/model_centre.h"
 
 using epichead::vision::build_model;
 using epichead::vision::CadModel;
@@ -192,6 +193,11 @@ TEST_CASE("the real tea box model loads as a closed box with outward normals") {
 
 TEST_CASE("the second tea box sequence's model loads as a closed box") {
   check_box_topology(load_ok(std::string(EPICHEAD_SHARED_DATA) + "/teabox_left/model.cao"));
+}
+
+TEST_CASE("model_centre: the mean of the vertices, the origin for a model without any") {
+  CHECK(epichead::vision::model_centre(load_ok(kData + "cube.cao")).isApprox(Eigen::Vector3d(0.05, 0.05, 0.05)));
+  CHECK(epichead::vision::model_centre(CadModel{}) == Eigen::Vector3d::Zero());
 }
 
 TEST_CASE("the cube fixture is a closed unit box with axis normals") {
