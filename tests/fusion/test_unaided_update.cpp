@@ -64,12 +64,14 @@ struct Unaided {
     const Eigen::Vector3d d = traj.params().gravity_dir_obj.normalized();
     return angle_between(p->cam_T_obj.linear() * d, traj.at(t).x.cam_T_obj().linear() * d);
   }
+  // A unit direction across the down, in the camera (= IMU) frame, at the current time.
+  Eigen::Vector3d across_down() const {
+    return (traj.at(t_s).x.obj_R_cam.transpose() * traj.params().gravity_dir_obj).normalized().unitOrthogonal();
+  }
   // Turns the gyro by rate_radps about an axis across the down for duration_s from now: the filter
   // comes out tilted by rate x duration, and its covariance does not know it.
   void tilt_by_gyro(double rate_radps, double duration_s) {
-    const double t0 = t_s;
-    const Eigen::Vector3d across =
-        (traj.at(t0).x.obj_R_cam.transpose() * traj.params().gravity_dir_obj).normalized().unitOrthogonal();
+    const Eigen::Vector3d across = across_down();
     t_s += duration_s;
     feed_until(t_s, [&](ImuSample& s) { s.gyro_radps += rate_radps * across; });
   }
@@ -233,8 +235,7 @@ TEST_CASE("Predictor back after a gap: a pose the drifted filter gates re-initia
     // 0.45 s without vision in which the accelerometer reads 1 m/s^2 the camera does not have (a
     // burst the frames had not pinned down): the filter drifts ~0.1 m, and its covariance says a
     // few millimetres.
-    const Eigen::Vector3d across =
-        (run.traj.at(run.t_s).x.obj_R_cam.transpose() * run.traj.params().gravity_dir_obj).normalized().unitOrthogonal();
+    const Eigen::Vector3d across = run.across_down();
     run.t_s += 0.45;
     run.feed_until(run.t_s + 0.001, [&](ImuSample& s) { s.accel_mps2 += 1.0 * across; });
     const auto drifted = run.predictor.predict(run.t_s);
