@@ -18,6 +18,7 @@
 #include <expected>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -42,6 +43,8 @@
 #include "epichead/vision/model_centre.h"
 #include "epichead/vision/model_symmetry.h"
 #include "epichead/vision/offline/overlay.h"
+#include "epichead/vision/offline/score.h"
+#include "epichead/vision/revolution_axis.h"
 #include "epichead/vision/visibility.h"
 
 namespace epichead::tools {
@@ -211,9 +214,12 @@ class TruthMeter {
 
 // Each published frame against the truth: success (5 cm / 5 deg), the soak's attitude error,
 // and the overlays.
-// `symmetries`: the model's own (model_symmetry.h), since a detected start may be any of them.
+// `symmetries`: the model's own (model_symmetry.h), since a detected start may be any of them;
+// `free_axis_obj`: a body of revolution's axis, whose turn is removed first (as `score
+// --sym-axis`), since its edges cannot show it.
 void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunArgs& a,
-                   const std::vector<Eigen::Isometry3d>& symmetries, RunMeasures& m) {
+                   const std::vector<Eigen::Isometry3d>& symmetries, const std::optional<Eigen::Vector3d>& free_axis_obj,
+                   RunMeasures& m) {
   if (a.soak) {
     auto truth = w.truth_at(f.exposure_t_s);
     if (truth && m.errors_filled < m.errors.size()) {
@@ -239,7 +245,8 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
     if (auto truth = w.truth_at(f.exposure_t_s)) {
       bool success = false;
       for (std::size_t k = 0; k <= symmetries.size() && !success; ++k) {
-        const Eigen::Isometry3d est = k == 0 ? f.report->cam_T_obj : f.report->cam_T_obj * symmetries[k - 1];
+        Eigen::Isometry3d est = k == 0 ? f.report->cam_T_obj : f.report->cam_T_obj * symmetries[k - 1];
+        if (free_axis_obj) est.linear() = vision::remove_turn(truth->cam_T_obj.linear(), est.linear(), *free_axis_obj);
         const double rot_deg = Eigen::AngleAxisd(est.linear() * truth->cam_T_obj.linear().transpose()).angle() * 180 / M_PI;
         const double t_m = (est.translation() - truth->cam_T_obj.translation()).norm();
         success = rot_deg <= 5.0 && t_m <= 0.05;
@@ -289,6 +296,8 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   }
   const vision::Camera cam = w.camera_model();
   const std::vector<Eigen::Isometry3d> symmetries = vision::model_symmetries(*model);
+  std::optional<Eigen::Vector3d> free_axis_obj;
+  if (const auto axis = vision::find_revolution_axis(*model)) free_axis_obj = axis->direction_obj.normalized();
   TruthMeter meter(w, *model, a, m);
   if (render && !a.soak)
     if (auto ok = meter.open_timeline((fs::path(out) / "timeline.csv").string()); !ok) return std::unexpected(ok.error());
@@ -325,7 +334,7 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   // Sized up front (so its pages are resident before the baseline): the measuring must not grow.
   if (a.soak) m.errors.assign(static_cast<std::size_t>(until * scenario.fps) + 16, FrameError{});
   const head::FrameHook hook = [&](const head::TrackedFrame& f) {
-    measure_frame(f, w, a, symmetries, m);
+    measure_frame(f, w, a, symmetries, free_axis_obj, m);
     if (!render || a.every <= 0 || f.index % static_cast<std::uint64_t>(a.every) != 0) return;
     overlays += write_overlay(f, *model, cam, out);
   };

@@ -33,6 +33,7 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                                           {"detections_found", s.detections_found},
                                           {"losses", s.losses},
                                           {"reacquisitions", s.reacquisitions},
+                                          {"levelled_to_gravity", s.levelled_to_gravity},
                                           {"against_gravity", s.against_gravity},
                                           {"first_detection_t_s", s.first_detection_t_s},
                                           {"detect_ms_max", s.detect_ms_max}}},

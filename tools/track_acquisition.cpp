@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "level_to_gravity.h"
+#include "epichead/geometry/level_to_up.h"
 #include "epichead/vision/model_centre.h"
 
 namespace epichead::tools {
@@ -143,7 +143,7 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   if (!found) return {};
   // With the IMU and the object's down learnt, the tilt is gravity's, not the outline's.
   if (const auto up = predictor.upright(t_s)) {
-    found = level_to_gravity(*found, *up, centre_obj_);
+    found = geometry::level_to_up(*found, up->up_obj, up->up_cam, centre_obj_);
     ++levelled_;
   }
   tracker.reset();

@@ -82,7 +82,7 @@ class TrackAcquisition {
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
   std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a degraded frame started
   Eigen::Vector3d centre_obj_;  // vision::model_centre: levelled poses turn about it
-  int levelled_ = 0;                                     // found poses levelled to gravity (level_to_gravity.h)
+  int levelled_ = 0;                                     // found poses levelled to gravity (geometry/level_to_up.h)
   int rechecks_ = 0, switches_ = 0;
   double last_score_ = 0;
   nlohmann::json recheck_log_ = nlohmann::json::array();  // of the last detection's best hypothesis

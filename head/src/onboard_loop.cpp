@@ -254,6 +254,7 @@ struct OnboardLoop::Impl {
       summary.detect_ms_max = std::max(summary.detect_ms_max, r.track_ms);
       if (r.found && !against_gravity) {
         ++summary.detections_found;
+        summary.levelled_to_gravity += r.levelled;
         if (have_pose) ++summary.reacquisitions;
         if (summary.first_detection_t_s < 0) summary.first_detection_t_s = r.exposure_t_s;
       }

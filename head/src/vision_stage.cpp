@@ -5,6 +5,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "epichead/geometry/level_to_up.h"
+#include "epichead/vision/model_centre.h"
+
 namespace epichead::head {
 
 cv::Mat as_image(const hw::CameraFrame& f, cv::Mat& scratch) {
@@ -22,7 +25,11 @@ cv::Mat as_image(const hw::CameraFrame& f, cv::Mat& scratch) {
 VisionStage::VisionStage(const vision::CadModel& model, const vision::Camera& camera,
                          const vision::ModelTrackerOptions& options, VisionThreads threads, double processing_s,
                          const hw::Clock& clock)
-    : tracker_(model, camera, options), threads_(threads), processing_s_(processing_s), clock_(clock) {}
+    : tracker_(model, camera, options),
+      centre_obj_(vision::model_centre(model)),
+      threads_(threads),
+      processing_s_(processing_s),
+      clock_(clock) {}
 
 VisionStage::~VisionStage() { stop(); }
 
@@ -65,6 +72,7 @@ void VisionStage::track_job() {
   result_.readable = !mat.empty() && image_.assign(mat).has_value();
   result_.detection = job_.detect && detector_ != nullptr;
   result_.found = false;
+  result_.levelled = false;
   if (result_.readable && result_.detection) detect_job(mat);
   else if (result_.readable) tracker_.track(image_, job_.predicted, report_);
   result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -85,10 +93,18 @@ void VisionStage::detect_job(const cv::Mat& mat) {
     report_.cam_T_obj = job_.predicted;
     return;
   }
+  // With the down learnt (the ups given), the found pose is levelled to the measured up before the
+  // tracker and the predictor start from it, as `track` does: an outline's refinement can settle a
+  // few degrees tilted (the can's label band), and a filter seeded there keeps that tilt.
+  Eigen::Isometry3d start = r->best.cam_T_obj;
+  if (job_.up_cam && job_.up_obj) {
+    start = geometry::level_to_up(start, *job_.up_obj, *job_.up_cam, centre_obj_);
+    result_.levelled = true;
+  }
   tracker_.reset();
-  tracker_.track(image_, r->best.cam_T_obj, report_);
+  tracker_.track(image_, start, report_);
   report_.reasons = report_.reasons | vision::TrackReason::Reacquired;
-  result_.predicted = r->best.cam_T_obj;
+  result_.predicted = start;
 }
 
 void VisionStage::submit(double now_s) {

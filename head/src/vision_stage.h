@@ -61,6 +61,7 @@ struct VisionResult {
   const hw::CameraFrame* image = nullptr;
   bool detection = false;  // the job was a detection (found: the report is the tracking step from its pose)
   bool found = false;
+  bool levelled = false;   // found with the ups known: the pose was levelled to them before tracking
 };
 
 class VisionStage {
@@ -100,6 +101,7 @@ class VisionStage {
 
   void detect_job(const cv::Mat& mat);
   vision::ModelTracker tracker_;
+  Eigen::Vector3d centre_obj_;  // vision::model_centre: a levelled detection turns about it
   vision::Detector* detector_ = nullptr;
   double detection_processing_s_ = 0.3;
   VisionThreads threads_;

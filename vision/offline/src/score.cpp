@@ -25,16 +25,6 @@ double rotation_angle_deg(const Eigen::Matrix3d& R) {
   return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())) * 180.0 / std::numbers::pi;
 }
 
-// R_est * Rot(axis, theta) with theta minimising the angle to R_gt. With q = quat(R_gt^T R_est)
-// = (w, v), the product with (cos(theta/2), axis sin(theta/2)) has scalar part
-// w cos(theta/2) - (v.axis) sin(theta/2), whose magnitude (the cosine of half the error angle)
-// is largest at theta/2 = atan2(-(v.axis), w).
-Eigen::Matrix3d remove_turn(const Eigen::Matrix3d& R_gt, const Eigen::Matrix3d& R_est, const Eigen::Vector3d& axis) {
-  const Eigen::Quaterniond q(R_gt.transpose() * R_est);
-  const double theta = 2.0 * std::atan2(-q.vec().dot(axis), q.w());
-  return R_est * Eigen::AngleAxisd(theta, axis).toRotationMatrix();
-}
-
 // The object points whose reprojection is compared: vertices, or for models without any,
 // the circle centres and cylinder axis end points.
 std::vector<Eigen::Vector3d> reprojection_points(const CadModel& model) {
@@ -88,6 +78,15 @@ ErrorStats stats_of(std::vector<double> values) {
 }
 
 }  // namespace
+
+Eigen::Matrix3d remove_turn(const Eigen::Matrix3d& R_gt, const Eigen::Matrix3d& R_est, const Eigen::Vector3d& axis) {
+  // With q = quat(R_gt^T R_est) = (w, v), the product with (cos(theta/2), axis sin(theta/2)) has
+  // scalar part w cos(theta/2) - (v.axis) sin(theta/2), whose magnitude (the cosine of half the
+  // error angle) is largest at theta/2 = atan2(-(v.axis), w).
+  const Eigen::Quaterniond q(R_gt.transpose() * R_est);
+  const double theta = 2.0 * std::atan2(-q.vec().dot(axis), q.w());
+  return R_est * Eigen::AngleAxisd(theta, axis).toRotationMatrix();
+}
 
 ScoreSummary score_poses(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimates,
                          const Camera& camera, const CadModel& model,

@@ -52,6 +52,10 @@ struct ScoreSummary {
   std::vector<FrameScore> per_frame;
 };
 
+// R_est turned about `axis` (unit, object frame) by the angle that brings it closest to R_gt:
+// for a body of revolution, whose turn about its axis edges cannot show.
+Eigen::Matrix3d remove_turn(const Eigen::Matrix3d& R_gt, const Eigen::Matrix3d& R_est, const Eigen::Vector3d& axis);
+
 // Scores `estimates` against `ground_truth` frame by frame (matched on the frame column).
 // A ground-truth frame without an estimate, or whose estimate has status "lost", fails. With sym_axis_obj (a unit axis through the
 // object origin), the turn about it that makes the estimate closest to the truth is removed

@@ -1,4 +1,4 @@
-// A detected pose levelled to the measured up (tools/level_to_gravity.h): the object's up along
+// A detected pose levelled to the measured up (geometry/level_to_up.h): the object's up along
 // the camera's up afterwards, the model's centre where the image showed it, the turn about the up
 // kept; nothing done without a usable up.
 #include <catch2/catch.hpp>
@@ -6,14 +6,19 @@
 #include <cmath>
 #include <limits>
 
-#include "level_to_gravity.h"
+#include "epichead/geometry/level_to_up.h"
 
-using epichead::tools::level_to_gravity;
-using epichead::tools::Upright;
+using epichead::geometry::level_to_up;
 
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+
+// The camera's up (-y) and the object's (+z).
+struct Up {
+  Eigen::Vector3d up_cam, up_obj;
+};
+const Up kUp{Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)};
 
 double angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
@@ -30,12 +35,12 @@ Eigen::Isometry3d object_pose(double tilt_deg) {
 
 }  // namespace
 
-TEST_CASE("level_to_gravity: a detection tilted 9 deg is turned upright about the model's centre, its heading kept") {
-  const Upright up{Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1), 10 * kDeg};
+TEST_CASE("level_to_up: a detection tilted 9 deg is turned upright about the model's centre, its heading kept") {
+  const Up up = kUp;
   const Eigen::Vector3d centre(0, 0, 0.06);
   const Eigen::Isometry3d tilted = object_pose(9);
   REQUIRE(angle(tilted.linear() * up.up_obj, up.up_cam) == Approx(9 * kDeg));
-  const Eigen::Isometry3d level = level_to_gravity(tilted, up, centre);
+  const Eigen::Isometry3d level = level_to_up(tilted, up.up_obj, up.up_cam, centre);
   CHECK(angle(level.linear() * up.up_obj, up.up_cam) < 1e-9);
   CHECK(((level * centre) - (tilted * centre)).norm() < 1e-12);
   // The turn about the up: the object's x seen from the camera, across the up, as the untilted pose has it.
@@ -46,12 +51,12 @@ TEST_CASE("level_to_gravity: a detection tilted 9 deg is turned upright about th
   CHECK(angle(heading(level), heading(object_pose(0))) < 0.5 * kDeg);
 }
 
-TEST_CASE("level_to_gravity: an upright pose is kept, and a non-finite up changes nothing") {
-  const Upright up{Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1), 10 * kDeg};
+TEST_CASE("level_to_up: an upright pose is kept, and a non-finite up changes nothing") {
+  const Up up = kUp;
   const Eigen::Isometry3d upright = object_pose(0);
-  CHECK(level_to_gravity(upright, up, Eigen::Vector3d::Zero()).isApprox(upright, 1e-12));
-  Upright broken = up;
-  broken.up_cam = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  CHECK(level_to_up(upright, up.up_obj, up.up_cam, Eigen::Vector3d::Zero()).isApprox(upright, 1e-12));
+  const Eigen::Vector3d broken = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   const Eigen::Isometry3d tilted = object_pose(9);
-  CHECK(level_to_gravity(tilted, broken, Eigen::Vector3d::Zero()).isApprox(tilted, 0.0));
+  CHECK(level_to_up(tilted, up.up_obj, broken, Eigen::Vector3d::Zero()).isApprox(tilted, 0.0));
+  CHECK(level_to_up(tilted, up.up_obj, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()).isApprox(tilted, 0.0));
 }
