@@ -29,7 +29,6 @@
 #include "progress.h"
 #include "selected_lines.h"
 #include "track_acquisition.h"
-#include "epichead/fusion/predictor_options.h"
 #include "track_prediction.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/overlay.h"
@@ -53,9 +52,6 @@ struct TrackArgs {
   double crease_deg = 20.0;
   double max_view_deg = 85.0;
   std::string imu_time_offset = "auto";
-  double vision_error_time_s = fusion::PredictorOptions{}.vision_error_time_s;
-  double vision_error_turn_deg = fusion::PredictorOptions{}.vision_error_turn_rad * 180 / M_PI;
-  double repeating_noise_share = PoseOptions{}.repeating_noise_share;
   std::string free_turn = "auto";
   bool settle = true;
   bool outline_colours = true;
@@ -241,7 +237,6 @@ ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
   options.lines.epic.ransac.seed = args.ransac_seed;
   options.free_turn_of_revolution = args.free_turn == "auto";
   options.settle = args.settle;
-  options.pose.repeating_noise_share = args.repeating_noise_share;
   options.outline_colours = args.outline_colours;
   return options;
 }
@@ -256,21 +251,16 @@ void warn_dropped_imu(const nlohmann::json& predictor) {
                static_cast<unsigned long long>(predictor.value("imu_saturated", std::uint64_t{0})));
 }
 
-VisionErrorModel vision_error_model(const TrackArgs& args) {
-  return {args.vision_error_time_s, args.vision_error_turn_deg * M_PI / 180};
-}
-
 // Detection for the start in one frame: the predictor made from the found pose (the sequence's
 // init set to it), or nothing when the object was not found.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> start_from_detection(Sequence& seq, TrackAcquisition& acquisition,
                                                                                  const cv::Mat& frame, const FrameEntry& entry,
-                                                                                 bool imu, std::optional<double> offset,
-                                                                                 const VisionErrorModel& vision_error) {
+                                                                                 bool imu, std::optional<double> offset) {
   const auto found = acquisition.find_start(frame, entry.frame, entry.t_s);
   if (!found) return std::unexpected(found.error());
   if (!*found) return std::unique_ptr<TrackPredictor>{};
   seq.set_init({entry.frame, entry.t_s, **found, ""});
-  return make_track_predictor(seq, imu, offset, vision_error);
+  return make_track_predictor(seq, imu, offset);
 }
 
 struct TrackCounts {
@@ -324,7 +314,7 @@ int run_track(const TrackArgs& args) {
   if (const auto up = object_up(args.acquisition.detection); !up) return fail(cmd, up.error());
   // Without init.csv the predictor is made once detection has found the start.
   std::expected<std::unique_ptr<TrackPredictor>, std::string> predictor = std::unique_ptr<TrackPredictor>{};
-  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset, vision_error_model(args));
+  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -370,8 +360,7 @@ int run_track(const TrackArgs& args) {
     const FrameEntry& entry = seq->frames()[i];
     if (!*predictor) {
       // No start yet: detect in this frame; frames before the start have no pose.
-      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset,
-                                              vision_error_model(args));
+      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset);
       if (!started) return fail(cmd, started.error());
       if (!*started) {
         ++counts.searched_frames;
@@ -477,19 +466,6 @@ const CommandRegistration registration{
       app.add_option("--imu-time-offset-s", a->imu_time_offset,
                      "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset), s, or 'auto' "
                      "(default: estimated from the gyro and the tracked poses once the camera has turned enough)");
-      app.add_option("--vision-error-time-s", a->vision_error_time_s,
-                     "With --imu on: carry the error successive poses share (the same edges seen from nearly the same "
-                     "place) as a filter state that forgets with this time constant, s. 0: not carried, the poses' "
-                     "errors are independent (default)")
-          ->check(CLI::Range(0.0, 3600.0));
-      app.add_option("--vision-error-turn-deg", a->vision_error_turn_deg,
-                     "With --vision-error-time-s: the carried error also forgets as the camera turns, by e^-1 per this "
-                     "many degrees (0: time alone, the default)")
-          ->check(CLI::Range(0.0, 360.0));
-      app.add_option("--repeating-noise-share", a->repeating_noise_share,
-                     "The share of the edgels' own noise that the next frames repeat, reported with the lines' shared "
-                     "errors as the correlated covariance (0 to 0.99; default 0)")
-          ->check(CLI::Range(0.0, 0.99));
       app.add_flag("!--no-video", a->video, "Do not write overlay.mp4");
       app.add_option("--zoom", a->zoom, "PNG overlays show only this region (X,Y,W,H pixels), enlarged twice")
           ->delimiter(',')

@@ -187,7 +187,7 @@ class ImuPredictor final : public TrackPredictor {
     // ~0.3 m/s: the translation ran off 26 mm per frame (office_pan, development seed 3).
     if (seeded_by_init_ && t_s <= init_t_s_) predictor_.reset();
     seeded_by_init_ = false;
-    auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance, report.correlated_covariance);
+    auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
     // Vision and the filter disagree: which is wrong? A pose found only from the vision-only
     // extrapolation says the IMU's prediction had left the object; a run of gated poses that
@@ -198,7 +198,7 @@ class ImuPredictor final : public TrackPredictor {
     else supported_gated_ = 0;
     if ((report.used_fallback && strong) || supported_gated_ >= kSupportedGatedRestart) {
       predictor_.reset();
-      r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance, report.correlated_covariance);
+      r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
       supported_gated_ = 0;
       ++(report.used_fallback ? fallback_restarts_ : gated_restarts_);
     }
@@ -317,7 +317,7 @@ class ImuPredictor final : public TrackPredictor {
     next_ = 0;
     while (next_ < imu.size() && imu[next_].t_s - offset_s_ < t_s - options_.gravity_average_s - 0.05) ++next_;
     feed_until(t_s);
-    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance, report.correlated_covariance);
+    const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
     init_t_s_ = t_s;
   }
@@ -347,16 +347,13 @@ class ImuPredictor final : public TrackPredictor {
 }  // namespace
 
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s,
-                                                                                 const VisionErrorModel& vision_error) {
+                                                                                 std::optional<double> imu_time_offset_s) {
   if (use_imu) {
     if (!seq.has_imu()) return std::unexpected("--imu on: " + seq.dir() + " has no imu.csv");
     if (imu_time_offset_s && !std::isfinite(*imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
     options.imu_time_offset_s = imu_time_offset_s.value_or(0.0);
-    options.vision_error_time_s = vision_error.time_s;
-    options.vision_error_turn_rad = vision_error.turn_rad;
     // Disagreement is settled here with the pose's support (ImuPredictor::observe): a strongly
     // supported pose overrules the filter after three gated frames; a weak one only after half
     // a second of gated frames, when the filter is surely lost too.

@@ -59,14 +59,7 @@ class TrackPredictor {
 // runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset). Without a value
 // (auto) the offset starts at 0 and is estimated from the tracked poses and the gyro
 // (fusion/time_offset_estimator.h); once the estimate is confident the filter restarts with it.
-// The IMU filter's vision error state (fusion::PredictorOptions::vision_error_time_s and
-// vision_error_turn_rad; zero: not carried).
-struct VisionErrorModel {
-  double time_s = 0;
-  double turn_rad = 0;
-};
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s,
-                                                                                 const VisionErrorModel& vision_error);
+                                                                                 std::optional<double> imu_time_offset_s);
 
 }  // namespace epichead::tools

@@ -28,8 +28,7 @@ Eigen::Isometry3d to_cam_T_obj(const Eigen::Matrix3d& obj_R_cam, const Eigen::Ve
 
 }  // namespace
 
-bool ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                        const Matrix6d& /*correlated*/) {
+bool ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   t_s_ = t_s;
   obj_R_cam_ = cam_T_obj.linear().transpose();
   obj_p_cam_ = -(obj_R_cam_ * cam_T_obj.translation());
@@ -70,8 +69,7 @@ void ConstantVelocityFilter::propagate(double dt, Eigen::Matrix3d& R, Eigen::Vec
 }
 
 std::optional<PoseUpdateResult> ConstantVelocityFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj,
-                                                               const Matrix6d& cov, const Matrix6d& /*correlated*/,
-                                                               double gate_chi2) {
+                                                               const Matrix6d& cov, double gate_chi2) {
   Eigen::Matrix3d R = obj_R_cam_;
   Eigen::Vector3d pos = obj_p_cam_;
   Covariance P = P_;

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 #include "epichead/fusion/imu_propagation.h"
 #include "epichead/geometry/pose_covariance.h"
 #include "epichead/geometry/se3.h"
@@ -18,14 +16,6 @@ std::size_t history_capacity(const PredictorOptions& o) {
   return static_cast<std::size_t>(std::ceil(o.buffer_s * o.imu_rate_hz * 1.1)) + 8;
 }
 
-// A correlated covariance given in vision's convention (left perturbation of cam_T_obj, camera
-// frame) as the state's vision error (right perturbation, object frame): Ad^-1 C Ad^-T.
-Matrix6d to_object_frame(const Eigen::Isometry3d& cam_T_obj, const Matrix6d& correlated) {
-  const Matrix6d Ad_inv = geometry::se3_adjoint(cam_T_obj.inverse());
-  const Matrix6d C = Ad_inv * correlated * Ad_inv.transpose();
-  return 0.5 * (C + C.transpose());
-}
-
 }  // namespace
 
 ImuFilter::ImuFilter(const PredictorOptions& options) : options_(options), history_(history_capacity(options)) {}
@@ -33,17 +23,6 @@ ImuFilter::ImuFilter(const PredictorOptions& options) : options_(options), histo
 void ImuFilter::step(NavState& x, ErrorCovariance& P, const ImuSample& from, const ImuSample& to) const {
   propagate(x, P, from, to, options_.mount, options_.imu_noise);
   const double gap = to.t_s - from.t_s;
-  if (models_vision_error() && gap > 0) {
-    // First-order Gauss-Markov: e' = a e + w, var(w) = (1 - a^2) C, a = exp(-dt / tau - turn /
-    // turn_rad) with the camera's turn over the step from the gyro.
-    const double turn_rad = options_.vision_error_turn_rad;
-    const double turned = turn_rad > 0 ? (0.5 * (from.gyro_radps + to.gyro_radps) - x.gyro_bias_radps).norm() * gap / turn_rad : 0.0;
-    const double a = std::exp(-gap / options_.vision_error_time_s - turned);
-    x.vision_error *= a;
-    P.middleRows<6>(err::vision) *= a;
-    P.middleCols<6>(err::vision) *= a;
-    P.block<6, 6>(err::vision, err::vision) += (1 - a * a) * vision_error_cov_obj_;
-  }
   if (!(gap > options_.dropout_gap_s)) return;
   // Unknown rate w and acceleration a held over the gap: dtheta = w gap, dv = a gap,
   // dp = a gap^2 / 2 (cross terms between them left out).
@@ -107,8 +86,7 @@ void ImuFilter::repropagate_after(double t_s) {
   }
 }
 
-bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                           const Matrix6d& correlated) {
+bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   NavState x = nav_state_from(cam_T_obj);
   // Gravity from the accelerometer averaged over the window before the exposure time (not after
   // it, so that the result does not depend on how late the pose arrives), assuming the camera does not
@@ -138,15 +116,6 @@ bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const
   ErrorCovariance P = ErrorCovariance::Zero();
   const Matrix6d J = geometry::filter_pose_error_jacobian(x.obj_R_cam);
   P.topLeftCorner<6, 6>() = J * cov * J.transpose();
-  if (models_vision_error()) {
-    // The pose is off by its vision error e and its own noise n: J^-1 dx_pose = -(Ad e + n), so
-    // the pose's error keeps the whole covariance and is correlated with e by -J Ad C.
-    vision_error_cov_obj_ = to_object_frame(cam_T_obj, correlated);
-    const Eigen::Matrix<double, 6, 6> cross = -J * geometry::se3_adjoint(cam_T_obj) * vision_error_cov_obj_;
-    P.block<6, 6>(0, err::vision) = cross;
-    P.block<6, 6>(err::vision, 0) = cross.transpose();
-    P.block<6, 6>(err::vision, err::vision) = vision_error_cov_obj_;
-  }
   const auto sq = [](double s) { return s * s; };
   P.diagonal().segment<3>(err::v).setConstant(sq(options_.initial_speed_mps));
   P.diagonal().segment<3>(err::bg).setConstant(sq(options_.initial_gyro_bias_radps));
@@ -157,9 +126,8 @@ bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const
     x.gyro_bias_radps = carried_.gyro_bias_radps;
     x.accel_bias_mps2 = carried_.accel_bias_mps2;
     x.obj_R_grav = carried_.obj_R_grav;
-    // The motion blocks (velocity .. gravity) with their correlations; none with the new pose
-    // and its vision error.
-    constexpr int first = err::v, n = err::nav - err::v;
+    // The motion blocks (velocity .. gravity) with their correlations; none with the new pose.
+    constexpr int first = err::v, n = err::dim - err::v;
     P.block<n, n>(first, first) = carried_P_.block<n, n>(first, first);
     carry_pending_ = false;
   }
@@ -194,28 +162,12 @@ Matrix6d ImuFilter::with_timing_uncertainty(double t_s, const StateEntry& at_t, 
 }
 
 std::optional<PoseUpdateResult> ImuFilter::update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                                  const Matrix6d& correlated, double gate_chi2) {
+                                                  double gate_chi2) {
   StateEntry at_t;
   double extrapolated_s = 0;
   if (!state_at(t_s, at_t, extrapolated_s)) return std::nullopt;
-  Matrix6d noise = cov;
-  Matrix6d stationary = vision_error_cov_obj_;
-  if (models_vision_error()) {
-    noise = cov - correlated;
-    // The error this pose shares with the next ones, as its edges say. Where it exceeds what the
-    // state's vision error was modelled with (other edges seen now, fewer of them), the excess is
-    // new error, not yet in P.
-    stationary = to_object_frame(cam_T_obj, correlated);
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(stationary - vision_error_cov_obj_);
-    const Vector6d grown = eig.eigenvalues().cwiseMax(0.0);
-    at_t.P.block<6, 6>(err::vision, err::vision) += eig.eigenvectors() * grown.asDiagonal() * eig.eigenvectors().transpose();
-  }
-  // Gated against the pose's whole covariance: a pose whose shared error jumps (other edges
-  // taken, a part of the object newly in view) is not a wrong lock.
-  const PoseUpdateResult r = update_pose(at_t.x, at_t.P, cam_T_obj, with_timing_uncertainty(t_s, at_t, noise), gate_chi2,
-                                         models_vision_error() ? correlated : Matrix6d::Zero().eval());
+  const PoseUpdateResult r = update_pose(at_t.x, at_t.P, cam_T_obj, with_timing_uncertainty(t_s, at_t, cov), gate_chi2);
   if (!r.applied) return r;
-  vision_error_cov_obj_ = stationary;
   history_.set_anchor(at_t);
   repropagate_after(t_s);
   return r;
@@ -225,12 +177,10 @@ std::optional<PosePrediction> ImuFilter::predict(double t_s) const {
   StateEntry e;
   PosePrediction out;
   if (!state_at(t_s, e, out.extrapolated_s)) return std::nullopt;
-  // The pose's own error: the navigation block (the vision error does not move the true pose).
-  constexpr int n = err::nav;
-  const Eigen::Matrix<double, 6, n> H = pose_jacobian(e.x).leftCols<n>();
+  const PoseJacobian H = pose_jacobian(e.x);
   out.t_s = t_s;
   out.cam_T_obj = e.x.cam_T_obj();
-  out.covariance = H * e.P.topLeftCorner<n, n>() * H.transpose();
+  out.covariance = H * e.P * H.transpose();
   return out;
 }
 

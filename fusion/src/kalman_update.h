@@ -6,7 +6,6 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "epichead/fusion/nav_state.h"
 #include "epichead/geometry/se3.h"
 
 namespace epichead::fusion::detail {
@@ -36,26 +35,6 @@ double kalman_update(Eigen::Matrix<double, N, N>& P, const Eigen::Matrix<double,
   P = IKH * P * IKH.transpose() + K * Rm * K.transpose();
   P = 0.5 * (P + P.transpose()).eval();
   applied = true;
-  return d2;
-}
-
-// kalman_update on the filter's error state (nav_state.h). While the vision error is not carried
-// its rows and columns of P are zero, and the update is done on the navigation block alone: the
-// same arithmetic as a 17-dimensional filter (bit for bit: longer sums of zeros round
-// differently), and a third less of it.
-template <int M>
-double update_error_state(ErrorCovariance& P, const Eigen::Matrix<double, M, err::dim>& H, const Eigen::Matrix<double, M, 1>& r,
-                          const Eigen::Matrix<double, M, M>& Rm, double gate_chi2, ErrorVector& dx, bool& applied) {
-  constexpr int n = err::nav, v = err::dim - err::nav;
-  if (!P.bottomRows<v>().isZero(0)) return kalman_update<err::dim, M>(P, H, r, Rm, gate_chi2, dx, applied);
-  Eigen::Matrix<double, n, n> Pn = P.topLeftCorner<n, n>();
-  const Eigen::Matrix<double, M, n> Hn = H.template leftCols<n>();
-  Eigen::Matrix<double, n, 1> dxn;
-  const double d2 = kalman_update<n, M>(Pn, Hn, r, Rm, gate_chi2, dxn, applied);
-  if (!applied) return d2;
-  P.topLeftCorner<n, n>() = Pn;
-  dx.setZero();
-  dx.head<n>() = dxn;
   return d2;
 }
 

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "epichead/geometry/se3.h"
 #include "epichead/geometry/so3.h"
 
 namespace epichead::fusion {
@@ -47,7 +46,6 @@ void inject(NavState& x, const ErrorVector& dx) {
   x.gyro_bias_radps += dx.segment<3>(err::bg);
   x.accel_bias_mps2 += dx.segment<3>(err::ba);
   x.obj_R_grav = x.obj_R_grav * geometry::so3_exp(Eigen::Vector3d(dx[err::grav], dx[err::grav + 1], 0));
-  x.vision_error += dx.segment<6>(err::vision);
   // Re-orthonormalise so that round-off does not accumulate over thousands of updates.
   x.obj_R_cam = Eigen::Quaterniond(x.obj_R_cam).normalized().toRotationMatrix();
   x.obj_R_grav = Eigen::Quaterniond(x.obj_R_grav).normalized().toRotationMatrix();
@@ -68,7 +66,6 @@ ErrorVector error_between(const NavState& truth, const NavState& estimate) {
   const Eigen::Vector3d phi = axis.norm() > 0 ? Eigen::Vector3d(angle * axis.normalized()) : Eigen::Vector3d::Zero();
   dx[err::grav] = phi.x();
   dx[err::grav + 1] = phi.y();
-  dx.segment<6>(err::vision) = truth.vision_error - estimate.vision_error;
   return dx;
 }
 
@@ -78,18 +75,6 @@ PoseJacobian pose_jacobian(const NavState& x) {
   PoseJacobian H = PoseJacobian::Zero();
   H.block<3, 3>(0, err::p) = -x.obj_R_cam.transpose();
   H.block<3, 3>(3, err::theta) = -Eigen::Matrix3d::Identity();
-  return H;
-}
-
-Eigen::Isometry3d measured_cam_T_obj(const NavState& x) {
-  if (x.vision_error.isZero(0)) return x.cam_T_obj();
-  return x.cam_T_obj() * geometry::se3_exp(x.vision_error);
-}
-
-PoseJacobian measurement_jacobian(const NavState& x) {
-  // T exp(e) = exp(Ad_T e) T.
-  PoseJacobian H = pose_jacobian(x);
-  H.block<6, 6>(0, err::vision) = geometry::se3_adjoint(x.cam_T_obj());
   return H;
 }
 

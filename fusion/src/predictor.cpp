@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 #include "epichead/fusion/unaided_update.h"
 #include "epichead/geometry/pose_covariance.h"
 
@@ -18,19 +16,6 @@ bool usable_covariance(const Matrix6d& cov) {
   if (!cov.allFinite()) return false;
   if (!(cov - cov.transpose()).isZero(1e-9 * std::max(1.0, cov.cwiseAbs().maxCoeff()))) return false;
   return Eigen::LLT<Matrix6d>(cov).info() == Eigen::Success;
-}
-
-// A correlated part of a usable covariance: symmetric, positive semi-definite, and leaving a
-// positive-definite rest.
-bool usable_correlated(const Matrix6d& cov, const Matrix6d& correlated) {
-  if (!correlated.allFinite()) return false;
-  const double scale = std::max(1e-300, cov.cwiseAbs().maxCoeff());
-  if (!(correlated - correlated.transpose()).isZero(1e-9 * scale)) return false;
-  const Matrix6d rest = 0.5 * ((cov - correlated) + (cov - correlated).transpose());
-  if (Eigen::LLT<Matrix6d>(rest).info() != Eigen::Success) return false;
-  const double min_ev = Eigen::SelfAdjointEigenSolver<Matrix6d>(0.5 * (correlated + correlated.transpose()),
-                                                                Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
-  return min_ev >= -1e-9 * scale;
 }
 
 bool is_rotation(const Eigen::Matrix3d& R) {
@@ -60,8 +45,6 @@ std::expected<void, std::string> check(const PredictorOptions& o) {
   if (!non_negative(o.dropout_gyro_sigma_radps) || !non_negative(o.dropout_accel_sigma_mps2))
     return bad("dropout_*_sigma", "must be finite and >= 0");
   if (!positive(o.coast_after_s)) return bad("coast_after_s", "must be > 0");
-  if (!non_negative(o.vision_error_time_s) || !non_negative(o.vision_error_turn_rad))
-    return bad("vision_error_time_s/turn_rad", "must be finite and >= 0");
   if (!positive(o.gate_chi2)) return bad("gate_chi2", "must be > 0");
   if (o.reinit_after_gated < 1) return bad("reinit_after_gated", "must be >= 1");
   if (!positive(o.gravity_average_s)) return bad("gravity_average_s", "must be > 0");
@@ -229,8 +212,7 @@ void Predictor::update_unaided(double t_s) {
   }
 }
 
-VisionResult Predictor::initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                        const Matrix6d& correlated) {
+VisionResult Predictor::initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   PoseFilter& f = filter();
   PredictorCounters& c = status_.counters;
   // Never restart from a wrong lock: the down learnt before decides (the filter's own state,
@@ -242,7 +224,7 @@ VisionResult Predictor::initialise_from(double t_s, const Eigen::Isometry3d& cam
     ++c.vision_unchecked;
     return {VisionVerdict::Unchecked, 0};
   }
-  if (!f.initialise(t_s, cam_T_obj, cov, correlated)) {
+  if (!f.initialise(t_s, cam_T_obj, cov)) {
     ++c.vision_no_imu;
     return {VisionVerdict::NoImu, 0};
   }
@@ -258,27 +240,25 @@ VisionResult Predictor::initialise_from(double t_s, const Eigen::Isometry3d& cam
   return {VisionVerdict::Initialised, 0};
 }
 
-VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov_in,
-                                   const Matrix6d& correlated_in) {
+VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov_in) {
   PredictorCounters& c = status_.counters;
   const StateHistory& history = imu_.history();
   const bool far_ahead = options_.mode == PredictorMode::ImuAided && !history.empty() &&
                          t_s > history.newest_sample().t_s + options_.buffer_s;
   if (!finite(t_s) || far_ahead || !cam_T_obj.matrix().allFinite() || !is_rotation(cam_T_obj.linear()) ||
-      !usable_covariance(cov_in) || !usable_correlated(cov_in, correlated_in)) {
+      !usable_covariance(cov_in)) {
     ++c.vision_bad_input;
     return {VisionVerdict::BadInput, 0};
   }
   const Matrix6d cov = 0.5 * (cov_in + cov_in.transpose());
-  const Matrix6d correlated = 0.5 * (correlated_in + correlated_in.transpose());
   PoseFilter& f = filter();
-  if (!initialised_ || reinit_pending_) return initialise_from(t_s, cam_T_obj, cov, correlated);
+  if (!initialised_ || reinit_pending_) return initialise_from(t_s, cam_T_obj, cov);
   // Poses come in exposure order; one older than the last applied would undo it on re-propagation.
   if (t_s <= f.update_t_s()) {
     ++c.vision_out_of_order;
     return {VisionVerdict::OutOfOrder, 0};
   }
-  const std::optional<PoseUpdateResult> r = f.update(t_s, cam_T_obj, cov, correlated, options_.gate_chi2);
+  const std::optional<PoseUpdateResult> r = f.update(t_s, cam_T_obj, cov, options_.gate_chi2);
   if (!r) {
     ++c.vision_too_old;
     return {VisionVerdict::TooOld, 0};
@@ -295,7 +275,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
       // tracker off too. The sensor's biases and the gravity direction are kept; the velocity
       // starts again from zero.
       carry_sensor_state();
-      const VisionResult re = initialise_from(t_s, cam_T_obj, cov, correlated);
+      const VisionResult re = initialise_from(t_s, cam_T_obj, cov);
       if (re.verdict == VisionVerdict::Initialised) {
         ++c.resumption_resets;
         return re;

@@ -30,16 +30,14 @@ DownUpdateResult update_down(NavState& x, ErrorCovariance& P, const Eigen::Vecto
   const Eigen::Vector2d r = B.transpose() * offset;
   Eigen::Matrix<double, 2, err::dim> H = Eigen::Matrix<double, 2, err::dim>::Zero();
   H.block<2, 3>(0, err::theta) = B.transpose() * geometry::skew(u);
-  constexpr int n = err::nav;  // the tilt's error: the navigation block
-  const Eigen::Matrix<double, 2, n> Hn = H.leftCols<n>();
-  const Eigen::Matrix2d tilt_cov = Hn * P.topLeftCorner<n, n>() * Hn.transpose();
+  const Eigen::Matrix2d tilt_cov = H * P * H.transpose();
   if (result.angle_rad > contradiction_rad && result.angle_rad * result.angle_rad > tilt_cov.diagonal().maxCoeff()) {
     P.block<3, 3>(err::theta, err::theta) += result.angle_rad * result.angle_rad * (Eigen::Matrix3d::Identity() - u * u.transpose());
     result.inflated = true;
   }
   ErrorVector dx;
   const Eigen::Matrix2d Rm = sigma_rad * sigma_rad * Eigen::Matrix2d::Identity();
-  detail::update_error_state<2>(P, H, r, Rm, std::numeric_limits<double>::infinity(), dx, result.applied);
+  detail::kalman_update<err::dim, 2>(P, H, r, Rm, std::numeric_limits<double>::infinity(), dx, result.applied);
   if (result.applied) inject(x, dx);
   return result;
 }
@@ -58,7 +56,7 @@ bool hold_position(NavState& x, ErrorCovariance& P, const Eigen::Vector3d& obj_p
   const Eigen::Matrix3d Rm = sigma_m * sigma_m * Eigen::Matrix3d::Identity();
   ErrorVector dx;
   bool applied = false;
-  detail::update_error_state<3>(P, H, r, Rm, std::numeric_limits<double>::infinity(), dx, applied);
+  detail::kalman_update<err::dim, 3>(P, H, r, Rm, std::numeric_limits<double>::infinity(), dx, applied);
   if (applied) inject(x, dx);
   return applied;
 }

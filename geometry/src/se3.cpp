@@ -25,15 +25,6 @@ Eigen::Isometry3d apply_left(const Vector6d& xi, const Eigen::Isometry3d& pose) 
   return out;
 }
 
-Matrix6d se3_adjoint(const Eigen::Isometry3d& T) {
-  const Eigen::Matrix3d R = T.linear();
-  Matrix6d A = Matrix6d::Zero();
-  A.topLeftCorner<3, 3>() = R;
-  A.topRightCorner<3, 3>() = skew(T.translation()) * R;
-  A.bottomRightCorner<3, 3>() = R;
-  return A;
-}
-
 Eigen::Matrix<double, 3, 6> left_point_jacobian(const Eigen::Vector3d& X) {
   Eigen::Matrix<double, 3, 6> J;
   J.leftCols<3>().setIdentity();

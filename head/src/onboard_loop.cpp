@@ -240,7 +240,7 @@ struct OnboardLoop::Impl {
     }
     if (status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
-      predictor.add_vision(r->exposure_t_s, report.cam_T_obj, report.covariance, report.correlated_covariance);
+      predictor.add_vision(r->exposure_t_s, report.cam_T_obj, report.covariance);
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
       target_publish_t_s = published;

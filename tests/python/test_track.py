@@ -30,10 +30,6 @@ def test_tracks_the_teabox_from_its_init_pose(teabox):
     assert r.pose.shape == (4, 4) and r.covariance.shape == (6, 6)
     np.testing.assert_allclose(r.covariance, r.covariance.T, atol=1e-12)
     assert np.all(np.linalg.eigvalsh(r.covariance) > 0)
-    # The part the next frames share (the lines' shared errors): within the covariance.
-    assert r.correlated_covariance.shape == (6, 6)
-    assert np.all(np.linalg.eigvalsh(r.correlated_covariance) > 0)
-    assert np.all(np.linalg.eigvalsh(r.covariance - r.correlated_covariance) > 0)
     assert r.visible >= 4 and r.inliers >= 4 and r.reasons == ""
     assert r.times_ms["total"] > 0
 
@@ -89,7 +85,7 @@ def test_tracks_from_the_constant_velocity_prediction(teabox):
         start = pose if prediction is None else prediction.pose
         r = tracker.track(teabox.read_frame(i), start)
         assert r.status == "tracked"
-        verdict, _ = predictor.add_vision(t, r.pose, r.covariance, r.correlated_covariance)
+        verdict, _ = predictor.add_vision(t, r.pose, r.covariance)
         assert verdict in ("applied", "initialised")
         pose = r.pose
     status = predictor.status(teabox.frames[FRAMES - 1].t_s)

@@ -5,8 +5,6 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Eigenvalues>
-
 #include "epichead/geometry/se3.h"
 #include "epichead/vision/pose_estimator.h"
 
@@ -258,38 +256,4 @@ TEST_CASE("errors a line's edgels share are in the covariance: Monte Carlo NEES 
   CHECK(nees_with > 4.5);
   CHECK(nees_with < 8.0);
   CHECK(nees_without > 30.0);
-}
-
-TEST_CASE("the correlated covariance is the shared part of the covariance, plus the repeating share of the edgel noise", "[pose]") {
-  std::mt19937 rng(12);
-  const auto truth = true_pose();
-  PoseProblem problem;
-  int id = 0;
-  for (const auto& [a, b] : box_edges()) problem.lines.push_back(observe_line(id++, a, b, truth, 0.3, rng));
-  const auto estimate = [&](double shared_px, double repeating) {
-    PoseOptions options;
-    options.line_shared_sigma_px = shared_px;
-    options.repeating_noise_share = repeating;
-    PoseEstimator estimator(kCamera, options);
-    PoseResult result;
-    estimator.estimate(problem, perturb(truth, 0.005, 0.01), result);
-    REQUIRE(result.status == PoseStatus::Ok);
-    return result;
-  };
-  const auto min_eigenvalue = [](const Eigen::Matrix<double, 6, 6>& m) {
-    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(m).eigenvalues().minCoeff();
-  };
-  const PoseResult independent = estimate(0.0, 0.0);
-  CHECK(independent.correlated_covariance.isZero(0));
-  const PoseResult shared = estimate(0.5, 0.0);
-  const Eigen::Matrix<double, 6, 6> own = shared.covariance - shared.correlated_covariance;
-  CHECK(min_eigenvalue(shared.correlated_covariance) > 0);
-  CHECK(min_eigenvalue(own) > 0);
-  // What is left is the edgel noise alone: the covariance without the shared errors.
-  CHECK((own - independent.covariance).cwiseAbs().maxCoeff() < 1e-9 * independent.covariance.cwiseAbs().maxCoeff());
-  // A share of the edgel noise moves to the correlated part; the covariance stays.
-  const PoseResult repeating = estimate(0.5, 0.75);
-  CHECK((repeating.covariance - shared.covariance).cwiseAbs().maxCoeff() < 1e-12 * shared.covariance.cwiseAbs().maxCoeff());
-  CHECK((repeating.covariance - repeating.correlated_covariance - 0.25 * own).cwiseAbs().maxCoeff() <
-        1e-9 * own.cwiseAbs().maxCoeff());
 }

@@ -75,16 +75,13 @@ void bind_fusion(py::module_& m) {
           "it was rejected")
       .def(
           "add_vision",
-          [](Predictor& p, double t_s, const Eigen::Matrix4d& pose, const Eigen::Matrix<double, 6, 6>& covariance,
-             const std::optional<Eigen::Matrix<double, 6, 6>>& correlated) {
-            const VisionResult r = p.add_vision(t_s, pose_from_matrix(pose, "pose"), covariance,
-                                                correlated ? *correlated : Eigen::Matrix<double, 6, 6>::Zero().eval());
+          [](Predictor& p, double t_s, const Eigen::Matrix4d& pose, const Eigen::Matrix<double, 6, 6>& covariance) {
+            const VisionResult r = p.add_vision(t_s, pose_from_matrix(pose, "pose"), covariance);
             return py::make_tuple(std::string(to_string(r.verdict)), r.mahalanobis2);
           },
-          py::arg("exposure_t_s"), py::arg("pose"), py::arg("covariance"), py::arg("correlated_covariance") = py::none(),
-          "A vision pose (e.g. FrameResult.pose, .covariance and .correlated_covariance) for the frame exposed at t_s "
-          "(camera clock); correlated_covariance, the part of covariance the next poses share, may be left out "
-          "(independent errors). Returns (verdict, squared Mahalanobis distance)")
+          py::arg("exposure_t_s"), py::arg("pose"), py::arg("covariance"),
+          "A vision pose (e.g. FrameResult.pose and .covariance) for the frame exposed at t_s (camera clock). "
+          "Returns (verdict, squared Mahalanobis distance)")
       .def("predict", &Predictor::predict, py::arg("t_s"),
            "The Prediction at t_s (camera clock), or None before the first pose")
       .def(

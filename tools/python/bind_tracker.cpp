@@ -154,9 +154,6 @@ void bind_tracker(py::module_& m) {
                              "4x4 cam_T_obj (the prediction when lost)")
       .def_property_readonly("covariance", [](const FrameResult& r) { return Eigen::Matrix<double, 6, 6>(r.report.covariance); },
                              "6x6 covariance of the left perturbation (translation, rotation)")
-      .def_property_readonly("correlated_covariance",
-                             [](const FrameResult& r) { return Eigen::Matrix<double, 6, 6>(r.report.correlated_covariance); },
-                             "6x6, the part of covariance the next frames share (the lines' shared errors)")
       .def_property_readonly("pose_status", [](const FrameResult& r) { return to_string(r.report.pose_status); })
       .def_property_readonly("scale_px", [](const FrameResult& r) { return r.report.scale_px; })
       .def_property_readonly("visible", [](const FrameResult& r) { return r.report.visible; }, "line windows placed")

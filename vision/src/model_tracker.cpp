@@ -273,7 +273,6 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
     }
     out.cam_T_obj = pose_.cam_T_obj;
     out.covariance = pose_.covariance;
-    out.correlated_covariance = pose_.correlated_covariance;
     out.scale_px = pose_.scale_px;
     int ellipse_inliers = 0;
     const std::size_t first_ellipse = problem_.lines.size() + problem_.points.size();

@@ -213,7 +213,6 @@ void degeneracy_and_covariance(const PoseProblem& problem, const PoseOptions& op
   // uncertainty ~10x on sharp edges: vision NIS medians of 0.05 where 5.3 is consistent).
   const double floor2 = options.min_noise_sigma * options.min_noise_sigma;
   const double sigma2 = std::max(floor2, ne.wsum > basis.dims ? ne.wr2 / (ne.wsum - basis.dims) : 1.0);
-  out.correlated_covariance.setZero();
   if (out.status != PoseStatus::Ok) {
     out.covariance = Matrix6d::Identity() * 1e6;
     return;
@@ -226,10 +225,8 @@ void degeneracy_and_covariance(const PoseProblem& problem, const PoseOptions& op
     const Eigen::Matrix<double, 6, 5> B = basis.B.leftCols<5>();
     H_inv = B * H_fixed.topLeftCorner<5, 5>().inverse() * B.transpose();
   }
-  // Independent edgel noise, plus what each line's edgels share (ne.shared); of the two, the
-  // shared errors and the repeating share of the edgel noise stay with the next frames.
+  // Independent edgel noise, plus what each line's edgels share (ne.shared).
   out.covariance = sigma2 * H_inv + H_inv * ne.shared * H_inv;
-  out.correlated_covariance = H_inv * ne.shared * H_inv + (std::clamp(options.repeating_noise_share, 0.0, 0.99) * sigma2) * H_inv;
   if (basis.dims < 6) {
     const double s = problem.free_turn_sigma_rad;
     out.covariance += (s * s) * basis.turn * basis.turn.transpose();

@@ -30,11 +30,10 @@ class ConstantVelocityFilter final : public PoseFilter {
   explicit ConstantVelocityFilter(const ConstantVelocityNoise& noise = {}) : noise_(noise) {}
 
   // Starts at the pose at t_s, at rest with the configured uncertainty of the twist (always true).
-  // Takes cov whole: the vision poses' shared error is not modelled here.
-  bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov, const Matrix6d& correlated) override;
+  bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) override;
   // Moves the state to t_s (t_s >= update_t_s()) and applies the gated pose update (never empty).
   std::optional<PoseUpdateResult> update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                         const Matrix6d& correlated, double gate_chi2) override;
+                                         double gate_chi2) override;
   // The pose at any t_s, extrapolated with the current twist (never empty).
   std::optional<PosePrediction> predict(double t_s) const override;
   double update_t_s() const override { return t_s_; }

@@ -27,12 +27,10 @@ class ImuFilter final : public PoseFilter {
 
   // PoseFilter. Initialisation takes gravity from the accelerometer over gravity_average_s before
   // t_s and re-propagates the later samples; an update is applied at t_s from the kept state
-  // before it (empty: t_s older than the history). With vision_error_time_s > 0 the correlated
-  // part of a pose's covariance goes to the state's vision error and only the rest is the
-  // update's measurement noise.
-  bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov, const Matrix6d& correlated) override;
+  // before it (empty: t_s older than the history).
+  bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) override;
   std::optional<PoseUpdateResult> update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                         const Matrix6d& correlated, double gate_chi2) override;
+                                         double gate_chi2) override;
   std::optional<PosePrediction> predict(double t_s) const override;
   double update_t_s() const override;
   void reset() override { history_.drop_states(); }
@@ -54,14 +52,12 @@ class ImuFilter final : public PoseFilter {
  private:
   // The filter state at t_s from the nearest earlier kept state; false when there is none.
   bool state_at(double t_s, StateEntry& out, double& extrapolated_s) const;
-  // propagate() plus the dropout inflation for a step longer than dropout_gap_s, and the vision
-  // error's decay.
+  // propagate() plus the dropout inflation for a step longer than dropout_gap_s.
   void step(NavState& x, ErrorCovariance& P, const ImuSample& from, const ImuSample& to) const;
   // Re-propagates the entries after t_s from the anchor.
   void repropagate_after(double t_s);
   // cov plus the pose's motion over the time offset's uncertainty (imu_time_offset_sigma_s).
   Matrix6d with_timing_uncertainty(double t_s, const StateEntry& at_t, const Matrix6d& cov) const;
-  bool models_vision_error() const { return options_.vision_error_time_s > 0; }
 
   PredictorOptions options_;
   StateHistory history_;
@@ -69,9 +65,6 @@ class ImuFilter final : public PoseFilter {
   bool carry_pending_ = false;  // carry_motion() given for the next initialisation
   NavState carried_;
   ErrorCovariance carried_P_ = ErrorCovariance::Zero();
-  // The vision error's stationary covariance (object frame, the state's vision_error order): the
-  // newest pose's correlated covariance, moved to the right. The process noise of its decay.
-  Matrix6d vision_error_cov_obj_ = Matrix6d::Zero();
 };
 
 }  // namespace epichead::fusion

@@ -18,11 +18,7 @@ constexpr int v = 6;       // camera velocity in the object frame, m/s
 constexpr int bg = 9;      // gyro bias, IMU frame, rad/s
 constexpr int ba = 12;     // accelerometer bias, IMU frame, m/s^2
 constexpr int grav = 15;   // gravity direction, 2 dof in the gravity frame, rad
-constexpr int nav = 17;    // the navigation error above; the vision error follows it
-// The error the vision poses share from frame to frame (NavState::vision_error): translation m,
-// rotation rad, object frame.
-constexpr int vision = 17;
-constexpr int dim = 23;
+constexpr int dim = 17;
 }  // namespace err
 
 using ErrorVector = Eigen::Matrix<double, err::dim, 1>;
@@ -38,12 +34,6 @@ struct NavState {
   // Gravity frame: gravity is (0, 0, -g) there. Its turn about gravity is meaningless and never
   // estimated; keeping a rotation (not a vector) gives a continuous 2-dof error basis.
   Eigen::Matrix3d obj_R_grav = Eigen::Matrix3d::Identity();
-  // What the tracker's poses are off by in common, frame after frame while it sees the same edges
-  // (a CAD model off by a millimetre, an edge's blur, a smooth body's facets; docs/fusion.md):
-  // measured cam_T_obj = cam_T_obj() * exp(vision_error), a right perturbation (translation, then
-  // rotation) in the object frame. A first-order Gauss-Markov process; zero when the filter is
-  // told the vision errors are independent.
-  Eigen::Matrix<double, 6, 1> vision_error = Eigen::Matrix<double, 6, 1>::Zero();
 
   Eigen::Vector3d gravity_obj_mps2() const;
   Eigen::Isometry3d cam_T_obj() const;
@@ -63,13 +53,6 @@ ErrorVector error_between(const NavState& truth, const NavState& estimate);
 
 // d(xi)/d(dx): how the error state moves the left perturbation xi = (rho, phi) of cam_T_obj.
 PoseJacobian pose_jacobian(const NavState& x);
-
-// The pose the tracker is expected to measure: cam_T_obj() with the vision error.
-Eigen::Isometry3d measured_cam_T_obj(const NavState& x);
-
-// d(xi)/d(dx) of measured_cam_T_obj: pose_jacobian plus the vision error's block, the adjoint of
-// cam_T_obj (it moves a right perturbation to the left).
-PoseJacobian measurement_jacobian(const NavState& x);
 
 // d(gravity_obj)/d(gravity error): the 3x2 block used in propagation.
 Eigen::Matrix<double, 3, 2> gravity_jacobian(const NavState& x);

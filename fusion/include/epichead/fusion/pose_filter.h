@@ -18,16 +18,13 @@ class PoseFilter {
   virtual ~PoseFilter() = default;
 
   // Starts (again) at the pose at t_s, covariance of its left perturbation cov (symmetric,
-  // positive definite), of which `correlated` (positive semi-definite, cov - correlated positive
-  // definite) is the part later poses share (a filter without a vision error state takes cov
-  // whole). False when it cannot start there (the IMU filter: no accelerometer reading before
-  // t_s); the filter is then unchanged.
-  virtual bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                          const Matrix6d& correlated) = 0;
+  // positive definite). False when it cannot start there (the IMU filter: no accelerometer
+  // reading before t_s); the filter is then unchanged.
+  virtual bool initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) = 0;
   // The gated update with the pose at t_s > update_t_s(); empty when the filter keeps no state
   // at t_s (older than its history). A gated pose leaves the filter as it was.
   virtual std::optional<PoseUpdateResult> update(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                                 const Matrix6d& correlated, double gate_chi2) = 0;
+                                                 double gate_chi2) = 0;
   // The pose at t_s; empty when there is no state to predict it from.
   virtual std::optional<PosePrediction> predict(double t_s) const = 0;
   // Exposure time of the last initialising or applied pose.

@@ -101,12 +101,7 @@ class Predictor {
   static std::expected<Predictor, std::string> create(const PredictorOptions& options);
 
   ImuVerdict add_imu(const ImuSample& sample);
-  // A tracked pose exposed at exposure_t_s with the covariance of its left perturbation `cov`, of
-  // which `correlated` is the part the next poses share (FrameReport::correlated_covariance;
-  // zero: the poses' errors are independent). BadInput unless cov is positive definite,
-  // correlated positive semi-definite and cov - correlated positive definite.
-  VisionResult add_vision(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                          const Matrix6d& correlated = Matrix6d::Zero());
+  VisionResult add_vision(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
   // The pose at t_s (camera clock); empty before initialisation or before the oldest kept state.
   std::optional<PosePrediction> predict(double t_s) const;
   // The down (unit) the accelerometer measures in the camera frame at t_s (learnt_gravity.h); empty
@@ -152,8 +147,7 @@ class Predictor {
   void note_hold(double t_s, const Eigen::Isometry3d& cam_T_obj);
   // The first pose, or the first after reset / a run of gated poses / a gap (never from a tilted
   // lock: the learnt down decides).
-  VisionResult initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                               const Matrix6d& correlated);
+  VisionResult initialise_from(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
   // A gated pose at t_s more than unaided.after_s after the last applied one, within
   // unaided.position_sigma_m of the held position: re-initialise from it (ImuAided only).
   bool resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const;

@@ -56,16 +56,6 @@ struct PredictorOptions {
   double dropout_gyro_sigma_radps = 1.0;
   double dropout_accel_sigma_mps2 = 2.0;
   double coast_after_s = 0.02;          // status().coasting when the newest sample is older than this
-  // Mode::ImuAided: the error successive vision poses share (the pose's correlated covariance,
-  // vision::PoseResult::correlated_covariance) carried as the state's vision_error, a first-order
-  // Gauss-Markov process that forgets with time (time constant vision_error_time_s) and with the
-  // camera's turn (vision_error_turn_rad: the view, and the pixels the edges fall on, change).
-  // While it is carried, a pose is gated against its whole covariance and updates the filter
-  // with the rest (docs/fusion.md, "The vision error as a state"). 0: not carried, every pose's
-  // whole covariance is independent noise (the default: on the development seeds carrying it
-  // cost success on some runs).
-  double vision_error_time_s = 0;
-  double vision_error_turn_rad = 0;  // 0: time alone
   double gate_chi2 = 22.46;             // chi-square, 6 dof, p = 0.999
   int reinit_after_gated = 5;           // this many gated poses in a row: re-initialise on the next
   double gravity_average_s = 0.1;       // accelerometer averaging window before the first pose

@@ -20,10 +20,6 @@ Vector6d se3_log(const Eigen::Isometry3d& T);
 // that round-off does not accumulate over many updates; pose's linear part a rotation.
 Eigen::Isometry3d apply_left(const Vector6d& xi, const Eigen::Isometry3d& pose);
 
-// The adjoint of T: T * se3_exp(xi) = se3_exp(se3_adjoint(T) * xi) * T, i.e. a right
-// perturbation moved to the left, [R, [t]x R; 0, R] in the (translation, rotation) order.
-Matrix6d se3_adjoint(const Eigen::Isometry3d& T);
-
 // d(se3_exp(xi) * X) / d(xi) at xi = 0, for the point X = pose * p: [I | -[X]x].
 Eigen::Matrix<double, 3, 6> left_point_jacobian(const Eigen::Vector3d& X);
 

@@ -118,9 +118,6 @@ struct FrameReport {
   // (PoseOptions::line_shared_sigma_px, a smooth body's facets): what a filter is given, and
   // what `track` writes to vision_covariance.csv for `score --covariance` to check.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
-  // The part of `covariance` the next frames share (the lines' shared errors,
-  // PoseResult::correlated_covariance): the IMU filter carries it as a slowly varying error.
-  Eigen::Matrix<double, 6, 6> correlated_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   PoseStatus pose_status = PoseStatus::Ok;
   double scale_px = 0;             // robust residual scale of the pose
   int pose_iterations = 0;         // Levenberg-Marquardt iterations over all rejection rounds

@@ -83,11 +83,6 @@ struct PoseOptions {
   // development seeds for a mean NEES near its degrees of freedom (docs/fusion.md, "Honest
   // vision covariance"). 0: edgels independent.
   double line_shared_sigma_px = 0.5;
-  // The share of the edgels' own noise (sigma^2 H^-1) that the next frames repeat: the same edges
-  // sampled at nearly the same pixels give nearly the same residuals. Reported, with the lines'
-  // shared errors, in PoseResult::correlated_covariance; the covariance itself does not change.
-  // 0: the edgel noise is new in every frame. Taken within [0, 0.99].
-  double repeating_noise_share = 0;
 };
 
 enum class PoseStatus {
@@ -111,9 +106,6 @@ struct PoseResult {
   // Covariance of the left perturbation (translation, rotation) applied to cam_T_obj
   // (geometry/pose_covariance.h).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
-  // The part of `covariance` from the errors each line's edgels share (the shared-error term):
-  // the next frames, seeing the same edges, share it too, while the rest is the edgels' own noise.
-  Eigen::Matrix<double, 6, 6> correlated_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   PoseStatus status = PoseStatus::Ok;
   std::string reason;  // for a status other than Ok
   int iterations = 0;
