@@ -236,8 +236,7 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
                                      lost ? std::nan("") : distance_mm(f.report->cam_T_obj)};
     }
   }
-  const auto& covers = w.scenario().covers;
-  if (std::any_of(covers.begin(), covers.end(), [&](const sim::CoverWindow& c) { return c.hides_object(f.exposure_t_s); })) {
+  if (auto hidden = w.object_hidden_at(f.exposure_t_s); hidden && *hidden) {
     ++m.hidden;
     return;
   }

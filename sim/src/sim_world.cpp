@@ -89,6 +89,9 @@ std::expected<std::unique_ptr<SimWorld>, std::string> SimWorld::create(const Sce
       scene = std::move(*made);
     }
     w->world_T_obj_ = scene->world_T_obj;
+    w->occlusion_.emplace(*scene, s);
+  } else if (varied) {
+    w->occlusion_.emplace(varied->scene, s);
   }
   const double exposure_s = s.exposure_s.value_or(scene ? scene->exposure_s : 0.008);
   const int subframes = s.blur_subframes.value_or(scene ? scene->blur_subframes : 1);
@@ -224,6 +227,12 @@ void SimWorld::deliver_to_nodes(const fw::CanFrame& frame, double t_s) {
     return;
   }
   ++stats_.host_frames_ignored;
+}
+
+std::expected<bool, std::string> SimWorld::object_hidden_at(double t_s) {
+  auto truth = truth_at(t_s);
+  if (!truth) return std::unexpected(truth.error());
+  return occlusion_ && occlusion_->hides_object(t_s, truth->world_T_cam);
 }
 
 std::expected<SimTruth, std::string> SimWorld::truth_at(double t_s) const {

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "epichead/sim/imu_model.h"
+#include "epichead/sim/occlusion_truth.h"
 #include "epichead/sim/renderer.h"
 #include "epichead/sim/rig.h"
 #include "epichead/sim/scene_library.h"
@@ -86,11 +87,12 @@ FrameRuns object_in_view_runs(const Scenario& s, const std::vector<vision::Stamp
   });
 }
 
-// The runs of frames in which a cover board hides the whole object: no tracker can measure it
-// there, so scoring leaves them out (a frame still being covered or uncovered counts).
-FrameRuns object_hidden_runs(const Scenario& s, const std::vector<vision::StampedPose>& gt) {
+// The runs of frames in which occluders (a cover board) hide the whole object: no tracker can
+// measure it there, so scoring leaves them out. Frames with any of it in sight count.
+FrameRuns object_hidden_runs(const Scene& scene, const Scenario& s, const std::vector<vision::StampedPose>& gt) {
+  OcclusionTruth occlusion(scene, s);
   return frame_runs(gt, [&](const vision::StampedPose& g) {
-    return std::any_of(s.covers.begin(), s.covers.end(), [&](const CoverWindow& w) { return w.hides_object(g.t_s); });
+    return occlusion.hides_object(g.t_s, scene.world_T_obj * g.cam_T_obj.inverse());
   });
 }
 
@@ -203,7 +205,7 @@ std::expected<SimSummary, std::string> write_sequence(const Scenario& scenario, 
   const HeadAngles head0 = rig.head_angles(s.frame_time_s(0));
   const std::string sim_truth =
       truth_json(s, exposure_s, subframes, summary, head0, imu, made->drawn,
-                 object_in_view_runs(s, gt, scene->model, *camera), object_hidden_runs(s, gt));
+                 object_in_view_runs(s, gt, scene->model, *camera), object_hidden_runs(*scene, s, gt));
   if (auto ok = write_text(dir / "sim_truth.json", sim_truth); !ok) return std::unexpected(ok.error());
   if (auto ok = write_text(dir / "scenario.scn", s.text); !ok) return std::unexpected(ok.error());
 

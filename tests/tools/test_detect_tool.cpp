@@ -155,9 +155,10 @@ TEST_CASE("track finds the package again after a board hides it for a second (bo
   CHECK(in_view[0][1] == 59);
   CHECK(in_view[1][0] == 108);
   CHECK(in_view[1][1] == 134);
-  // Hidden behind the board from 2.5 s to 3.5 s: frames 69 to 99, which scoring leaves out.
+  // Hidden behind the board (nothing of the package drawn) from the moment the sliding board
+  // fills the view, before 2.5 s, until after 3.5 s: frames 65 to 103, which scoring leaves out.
   const auto hidden = nlohmann::json::parse(slurp(seq + "/sim_truth.json"))["object_hidden_frames"];
-  CHECK(hidden.dump() == "[[69,99]]");
+  CHECK(hidden.dump() == "[[65,103]]");
   const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video" + kCache);
   INFO(run.out << run.err);
   REQUIRE(run.exit_code == 0);
@@ -172,8 +173,8 @@ TEST_CASE("track finds the package again after a board hides it for a second (bo
                                            q(tmp / "per_frame.csv") + " --json");
   REQUIRE(score.exit_code == 0);
   const auto scored = nlohmann::json::parse(score.out);
-  CHECK(scored["hidden_frames"] == 31);
-  CHECK(scored["frames"] == 135 - 31);
+  CHECK(scored["hidden_frames"] == 39);
+  CHECK(scored["frames"] == 135 - 39);
   // Every frame after the board has gone (3.8 s, frame 108) plus the few to find it again.
   std::ifstream per_frame(tmp / "per_frame.csv");
   std::string line;

@@ -39,12 +39,11 @@ struct OccluderKey {
 // completely (key `cover`): the tracker must notice the loss and recover afterwards.
 struct CoverWindow {
   static constexpr double kSlideS = 0.3;  // the board slides in before start_s and out after the end
-  double start_s = 0;     // the object is fully hidden from here
+  double start_s = 0;     // the board stands still in front of the camera from here
   double duration_s = 1;  // for this long
-  // The board is in front of the camera (sliding or still) at t_s.
+  // The board is in front of the camera (sliding or still) at t_s. Whether it hides the whole
+  // object is a question of what is drawn: OcclusionTruth (occlusion_truth.h).
   bool board_in_view(double t_s) const { return t_s >= start_s - kSlideS && t_s <= start_s + duration_s + kSlideS; }
-  // The board hides the whole object at t_s.
-  bool hides_object(double t_s) const { return t_s >= start_s && t_s <= start_s + duration_s; }
 };
 
 struct Scenario {

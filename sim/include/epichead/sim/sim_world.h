@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <expected>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -23,6 +24,7 @@
 #include "epichead/hw/can_bus.h"
 #include "epichead/hw/clock.h"
 #include "epichead/sim/head_mount.h"
+#include "epichead/sim/occlusion_truth.h"
 #include "epichead/sim/scenario.h"
 #include "epichead/sim/sim_camera.h"
 #include "epichead/sim/sim_can_bus.h"
@@ -85,6 +87,11 @@ class SimWorld {
   // Ground truth at t_s in [now - history_s, now]; outside: an error saying the range.
   std::expected<SimTruth, std::string> truth_at(double t_s) const;
 
+  // Whether occluders (a cover board) hide the whole object at t_s, seen from the true camera
+  // then (occlusion_truth.h); t_s as for truth_at. False for a world built without a scene
+  // (CameraOutput::Blank with a given aim and no covers).
+  std::expected<bool, std::string> object_hidden_at(double t_s);
+
   const Scenario& scenario() const { return scenario_; }
   const vision::Camera& camera_model() const { return camera_model_; }
   const Eigen::Isometry3d& world_T_obj() const { return world_T_obj_; }
@@ -114,6 +121,7 @@ class SimWorld {
   std::unique_ptr<SimHeadNode> head_;
   std::unique_ptr<SimImuNode> imu_;
   std::unique_ptr<SimCamera> camera_;
+  std::optional<OcclusionTruth> occlusion_;  // with a scene
   // Servo ticks, newest last, kept for history_s (truth_at, the camera's exposures); a new tick
   // overwrites the oldest.
   common::RingBuffer<HeadTick> history_;
