@@ -51,6 +51,7 @@ struct TrackArgs {
   bool video = true;
   double crease_deg = 20.0;
   double max_view_deg = 85.0;
+  int window_px = WindowOptions{}.width_px;
   std::string imu_time_offset = "auto";
   std::string free_turn = "auto";
   bool settle = true;
@@ -235,6 +236,7 @@ ModelTrackerOptions tracker_options(const TrackArgs& args, TrackMode mode) {
   options.visibility.crease_angle_rad = args.crease_deg * M_PI / 180.0;
   options.visibility.max_view_angle_rad = args.max_view_deg * M_PI / 180.0;
   options.lines.epic.ransac.seed = args.ransac_seed;
+  options.lines.window.width_px = args.window_px;
   options.free_turn_of_revolution = args.free_turn == "auto";
   options.settle = args.settle;
   options.outline_colours = args.outline_colours;
@@ -330,7 +332,7 @@ int run_track(const TrackArgs& args) {
   // to a wrong pose (held-out mockup_walk 105: 100 -> 5 %, the detection's outline scored 1.5x
   // the object's own, partly out of view); the rechecks after a degraded frame are for the
   // constant-velocity prediction.
-  acquisition_options.recheck.after_degraded = acquisition_options.recheck.after_degraded && args.imu == "off";
+  acquisition_options.recheck.after_doubt = acquisition_options.recheck.after_doubt && args.imu == "off";
   TrackAcquisition acquisition(*seq, options, acquisition_options);
   Visibility overlay_visibility(seq->model(), seq->camera(), options.visibility);
   VisibleModel at_estimate;
@@ -471,6 +473,10 @@ const CommandRegistration registration{
           ->delimiter(',')
           ->expected(4)
           ->check(CLI::NonNegativeNumber);
+      app.add_option("--window-px", a->window_px,
+                     "Samples across each model line's search window, px (default " + std::to_string(WindowOptions{}.width_px) +
+                         "): how far an edge may be from its predicted place; wider finds faster motion without the IMU, at more cost")
+          ->check(CLI::Range(8, kMaxWindowWidth));
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
       app.add_option("--max-view-deg", a->max_view_deg,
                      "Faces seen more edge-on than this (angle of normal to line of sight) count as turned away (default 85; 90: all front faces)")

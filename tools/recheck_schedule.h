@@ -3,7 +3,9 @@
 // wrong lock (tools/track_acquisition.h). A pose is provisional for provisional_s after it was
 // found by detection, or after a degraded frame: every recheck_interval_s meanwhile the search
 // runs again, and the caller switches to what it finds when that explains a much longer outline.
-// A degraded frame's first recheck is on that frame. No detection here: only the times.
+// So is a pose after a doubtful frame: a degraded one, or the first tracked again after a loss
+// (re-locked from the prediction, not found by detection). Its first recheck is on that frame.
+// No detection here: only the times.
 #include <cmath>
 
 #include "epichead/vision/model_tracker.h"
@@ -14,9 +16,10 @@ struct RecheckOptions {
   double provisional_s = 3.0;        // <= 0: no rechecks at all
   double recheck_interval_s = 0.5;
   // Without the IMU, a burst the constant-velocity prediction cannot follow leaves the tracker on
-  // a wrong lock that it then reports as tracked; the degraded frames on the way there are the
-  // only sign, and detection the only thing that tells the lock from the object.
-  bool after_degraded = true;
+  // a wrong lock that it then reports as tracked; the degraded frames, or lost frames it then
+  // re-locks from, on the way there are the only sign, and detection the only thing that tells
+  // the lock from the object.
+  bool after_doubt = true;
 };
 
 class RecheckSchedule {
@@ -28,13 +31,15 @@ class RecheckSchedule {
     provisional_until_s_ = t_s + options_.provisional_s;
     next_s_ = t_s + options_.recheck_interval_s;
   }
-  // After the tracker's frame at t_s: whether the search runs on it. A degraded frame outside a
-  // provisional stretch starts one, with its first recheck on this frame; a lost frame never
-  // rechecks (re-acquisition handles it).
-  bool due_after(vision::TrackStatus status, double t_s) {
+  // After the tracker's frame at t_s: whether the search runs on it. A doubtful frame (degraded,
+  // or `relocked`: tracked again from the prediction after lost frames) outside a provisional
+  // stretch starts one, with its first recheck on this frame; a lost frame never rechecks
+  // (re-acquisition handles it).
+  bool due_after(vision::TrackStatus status, double t_s, bool relocked = false) {
     if (status == vision::TrackStatus::Lost || !(options_.provisional_s > 0)) return false;
-    if (status == vision::TrackStatus::Degraded && options_.after_degraded && !(t_s <= provisional_until_s_)) {
-      ++after_degraded_;
+    const bool doubtful = status == vision::TrackStatus::Degraded || relocked;
+    if (doubtful && options_.after_doubt && !(t_s <= provisional_until_s_)) {
+      ++after_doubt_;
       provisional_until_s_ = t_s + options_.provisional_s;
       next_s_ = t_s;
     }
@@ -42,12 +47,12 @@ class RecheckSchedule {
     next_s_ = t_s + options_.recheck_interval_s;
     return true;
   }
-  int started_after_degraded() const { return after_degraded_; }
+  int started_after_doubt() const { return after_doubt_; }
 
  private:
   RecheckOptions options_;
   double provisional_until_s_ = -INFINITY, next_s_ = 0;
-  int after_degraded_ = 0;
+  int after_doubt_ = 0;
 };
 
 }  // namespace epichead::tools

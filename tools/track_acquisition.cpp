@@ -13,7 +13,7 @@ namespace {
 // --no-reacquire keeps the detected start's rechecks but starts none of its own after a degraded frame.
 RecheckOptions recheck_options(const AcquisitionOptions& o) {
   RecheckOptions r = o.recheck;
-  r.after_degraded = r.after_degraded && o.reacquire;
+  r.after_doubt = r.after_doubt && o.reacquire;
   return r;
 }
 
@@ -126,13 +126,14 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
     if (!again) return std::unexpected(again.error());
     found = *again;
   } else {
-    const int degraded_stretches = rechecks_due_.started_after_degraded();
-    const bool due = rechecks_due_.due_after(report.status, t_s);
-    // A stretch a degraded frame started: the tracked pose may be a wrong lock turned well away,
+    const int doubt_stretches = rechecks_due_.started_after_doubt();
+    const bool due = rechecks_due_.due_after(report.status, t_s, vision::has(report.reasons, vision::TrackReason::Reacquired));
+    // A stretch a doubtful frame started (degraded, or re-locked from the prediction after a
+    // loss: Reacquired without a detection): the tracked pose may be a wrong lock turned well away,
     // and of a symmetric model's outlines the one nearest it may be a twin of the object's. The
     // last pose tracked before it is the one to turn like (with the detected start's, the
     // tracked pose itself).
-    if (rechecks_due_.started_after_degraded() != degraded_stretches) orient_ref_ = last_tracked_;
+    if (rechecks_due_.started_after_doubt() != doubt_stretches) orient_ref_ = last_tracked_;
     if (due) {
       auto better = recheck(frame, t_s, report.cam_T_obj, orient_ref_ ? *orient_ref_ : report.cam_T_obj);
       if (!better) return std::unexpected(better.error());
@@ -163,7 +164,7 @@ nlohmann::json TrackAcquisition::to_json() const {
                       {"frames_to_reacquire", frames_to_reacquire_},
                       {"detections", detections_},
                       {"rechecks", rechecks_},
-                      {"rechecks_after_degraded", rechecks_due_.started_after_degraded()},
+                      {"recheck_stretches_after_doubt", rechecks_due_.started_after_doubt()},
                       {"levelled_to_gravity", levelled_},
                       {"switches", switches_},
                       {"recheck_log", recheck_log_},
