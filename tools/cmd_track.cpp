@@ -52,6 +52,7 @@ struct TrackArgs {
   double crease_deg = 20.0;
   double max_view_deg = 85.0;
   int window_px = WindowOptions{}.width_px;
+  double coast_s = 0.2;
   std::string imu_time_offset = "auto";
   std::string free_turn = "auto";
   bool settle = true;
@@ -269,6 +270,7 @@ struct TrackCounts {
   int tracked = 0, degraded = 0, lost = 0;
   int searched_frames = 0;  // before detection found the start
   int fused_frames = 0;     // frames whose poses.csv row is the filter's estimate
+  int predicted_frames = 0; // lost frames whose poses.csv row is the filter's propagation (--coast-s)
   int fallback_frames = 0;  // frames measured from the vision-only extrapolation
   int against_gravity = 0;  // tracked poses taken as lost: their tilt contradicts the accelerometer
 };
@@ -290,6 +292,7 @@ nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const Trac
   j["predictor"] = predictor ? predictor->diagnostics() : nlohmann::json(nullptr);
   j["searched_frames"] = c.searched_frames;
   j["fused_frames"] = c.fused_frames;
+  j["predicted_frames"] = c.predicted_frames;
   j["fallback_frames"] = c.fallback_frames;
   j["against_gravity_frames"] = c.against_gravity;
   if (tracker.free_turn()) {
@@ -408,6 +411,14 @@ int run_track(const TrackArgs& args) {
         status = to_string(TrackStatus::Degraded);
         ++counts.fused_frames;
       }
+    } else if (args.coast_s > 0) {
+      // Vision lost this frame (blur, a board sliding in), but the filter applied a pose a moment
+      // ago: its IMU propagation is the estimate, said so by the status. Longer, it drifts.
+      if (const auto f = (*predictor)->coasted(entry.t_s, args.coast_s)) {
+        estimate = *f;
+        status = "predicted";
+        ++counts.predicted_frames;
+      }
     }
     poses.push_back({entry.frame, entry.t_s, estimate, status});
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
@@ -441,9 +452,9 @@ int run_track(const TrackArgs& args) {
   std::ofstream rep(report_path);
   rep << j.dump(1) << '\n';
   if (!rep.flush()) return fail(cmd, "cannot write " + report_path);
-  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost; tracking %.3f ms median, %.3f ms p99\n", n,
-              args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, percentile(track_ms, 0.5),
-              percentile(track_ms, 0.99));
+  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost (%d of them predicted by the IMU); tracking %.3f ms median, %.3f ms p99\n", n,
+              args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, counts.predicted_frames,
+              percentile(track_ms, 0.5), percentile(track_ms, 0.99));
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
               args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");
   if (!overlays.video_note().empty()) std::fprintf(stderr, "track: %s\n", printable(overlays.video_note()).c_str());
@@ -473,6 +484,10 @@ const CommandRegistration registration{
           ->delimiter(',')
           ->expected(4)
           ->check(CLI::NonNegativeNumber);
+      app.add_option("--coast-s", a->coast_s,
+                     "With --imu on: a frame vision loses within this long of the filter's last vision pose gets the "
+                     "filter's IMU propagation, status 'predicted' (default 0.2; 0: such frames are 'lost')")
+          ->check(CLI::Range(0.0, 10.0));
       app.add_option("--window-px", a->window_px,
                      "Samples across each model line's search window, px (default " + std::to_string(WindowOptions{}.width_px) +
                          "): how far an edge may be from its predicted place; wider finds faster motion without the IMU, at more cost")

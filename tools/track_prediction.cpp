@@ -149,6 +149,7 @@ class ImuPredictor final : public TrackPredictor {
     pending_init_ = true;
     reset_done_ = false;
     supported_gated_ = 0;
+    last_applied_t_s_ = -INFINITY;  // a detected pose is not a tracked one
     ++detection_restarts_;
   }
   void observe(double t_s, const vision::FrameReport& report) override {
@@ -157,6 +158,7 @@ class ImuPredictor final : public TrackPredictor {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
         predictor_.reset();
+        last_applied_t_s_ = -INFINITY;
         reset_done_ = true;
         ++resets_;
       }
@@ -207,6 +209,11 @@ class ImuPredictor final : public TrackPredictor {
     if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld ||
         r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied)
       pending_init_ = false;
+    if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) last_applied_t_s_ = t_s;
+  }
+  std::optional<Eigen::Isometry3d> coasted(double t_s, double max_age_s) override {
+    if (!(t_s - last_applied_t_s_ <= max_age_s)) return std::nullopt;
+    return fused(t_s);
   }
   std::optional<Eigen::Isometry3d> fused(double t_s) override {
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;  // nothing before the filter starts
@@ -319,6 +326,7 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
+    if (!pending_init_) last_applied_t_s_ = t_s;
     init_t_s_ = t_s;
   }
   fusion::PredictorOptions options_;
@@ -328,6 +336,7 @@ class ImuPredictor final : public TrackPredictor {
   double offset_s_ = 0;
   Eigen::Isometry3d last_good_;
   double last_good_t_s_ = 0, init_t_s_ = 0;
+  double last_applied_t_s_ = -INFINITY;  // the filter's newest vision pose (applied or seeding it)
   bool pending_init_ = false, reset_done_ = false;
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;

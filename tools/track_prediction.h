@@ -33,6 +33,14 @@ class TrackPredictor {
   // weighed against the IMU's propagation, or the propagation alone when the pose was gated
   // out), or nothing when the predictor only extrapolates the vision poses.
   virtual std::optional<Eigen::Isometry3d> fused(double t_s) = 0;
+  // For a frame the tracker lost at t_s (after observe(t_s)): the filter's propagation when it
+  // applied a vision pose no longer than max_age_s before, or nothing (no IMU, or too long ago:
+  // the propagation is then the IMU's alone, drifting).
+  virtual std::optional<Eigen::Isometry3d> coasted(double t_s, double max_age_s) {
+    (void)t_s;
+    (void)max_age_s;
+    return std::nullopt;
+  }
   // A second opinion for a frame the tracker loses from predict(t_s): the vision poses
   // extrapolated alone, when the predictor is more than that (the IMU); nothing otherwise.
   virtual std::optional<Eigen::Isometry3d> fallback(double t_s) { (void)t_s; return std::nullopt; }

@@ -4,8 +4,13 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
@@ -153,4 +158,61 @@ TEST_CASE("track rejects bad arguments with one line and a non-zero exit") {
   r = run_epichead(tmp, "track --help");
   CHECK(r.exit_code == 0);
   CHECK(r.out.find("--mode") != std::string::npos);
+}
+
+TEST_CASE("track --imu on gives frames vision loses the filter's propagation, status predicted, for --coast-s after its last pose") {
+  TempDir tmp("epichead_test_track_coast");
+  const std::string seq = tmp / "mockup_walk";
+  REQUIRE(run_epichead(tmp, "sim mockup_walk --out " + q(seq) + " --frames 40").exit_code == 0);
+  // Frames 20 and 21 show nothing (a dropped exposure): vision loses both.
+  const cv::Mat frame = cv::imread(seq + "/frames/000020.png");
+  REQUIRE(!frame.empty());
+  for (const char* name : {"/frames/000020.png", "/frames/000021.png"})
+    REQUIRE(cv::imwrite(seq + name, cv::Mat(frame.size(), frame.type(), cv::Scalar::all(90))));
+  const std::string offset =
+      std::to_string(nlohmann::json::parse(slurp(seq + "/sim_truth.json"))["imu"]["clock_offset_s"].get<double>());
+  // Each frame's status and whether it is within the bounds.
+  struct Frame {
+    std::string status;
+    bool success = false;
+  };
+  const auto run = [&](const std::string& name, const std::string& coast) {
+    const std::string out = tmp / name;
+    const auto r = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --imu on --imu-time-offset-s " + offset +
+                                         " --every 0 --no-video" + coast);
+    INFO(r.out << r.err);
+    REQUIRE(r.exit_code == 0);
+    REQUIRE(run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " + q(out + "/f.csv")).exit_code == 0);
+    std::vector<Frame> frames(40);
+    std::ifstream poses(out + "/poses.csv"), scored(out + "/f.csv");
+    std::string line;
+    std::getline(poses, line);
+    while (std::getline(poses, line)) frames.at(static_cast<std::size_t>(std::stoi(line))).status = line.substr(line.rfind(',') + 1);
+    std::getline(scored, line);
+    while (std::getline(scored, line))
+      frames.at(static_cast<std::size_t>(std::stoi(line))).success = line.find(',' + std::string("1,1,")) == line.find(',');
+    const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+    CHECK(report["lost"].get<int>() >= 2);
+    return std::make_pair(frames, report["predicted_frames"].get<int>());
+  };
+  // By default (0.2 s): both lost frames are the IMU's propagation, and right.
+  const auto [coasted, predicted] = run("default", "");
+  CHECK(coasted[19].status == "tracked");
+  CHECK(coasted[20].status == "predicted");
+  CHECK(coasted[21].status == "predicted");
+  CHECK(coasted[20].success);
+  CHECK(coasted[21].success);
+  CHECK(coasted[22].status == "tracked");
+  CHECK(predicted == 2);
+  // Half a frame time past the last pose: the first only.
+  const auto [short_coast, short_predicted] = run("short", " --coast-s 0.05");
+  CHECK(short_coast[20].status == "predicted");
+  CHECK(short_coast[21].status == "lost");
+  CHECK_FALSE(short_coast[21].success);
+  CHECK(short_predicted == 1);
+  // Off: lost, as without the IMU.
+  const auto [off, off_predicted] = run("off", " --coast-s 0");
+  CHECK(off[20].status == "lost");
+  CHECK(off[21].status == "lost");
+  CHECK(off_predicted == 0);
 }

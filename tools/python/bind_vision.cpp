@@ -136,7 +136,7 @@ void bind_vision(py::module_& m) {
           "pose", [](const StampedPose& s) { return pose_matrix(s.cam_T_obj); },
           [](StampedPose& s, const Eigen::Matrix4d& p) { s.cam_T_obj = pose_from_matrix(p, "StampedPose.pose"); },
           "4x4 cam_T_obj")
-      .def_readwrite("status", &StampedPose::status, "tracked, degraded, lost (poses.csv); empty elsewhere")
+      .def_readwrite("status", &StampedPose::status, "tracked, degraded, predicted, lost (poses.csv); empty elsewhere")
       .def("__repr__", [](const StampedPose& s) {
         return "<epichead.StampedPose frame " + std::to_string(s.frame) + (s.status.empty() ? "" : " " + s.status) + ">";
       });

@@ -14,7 +14,7 @@ struct StampedPose {
   int frame = 0;
   double t_s = 0;
   Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
-  std::string status;  // poses.csv only (tracked, degraded, lost); empty elsewhere
+  std::string status;  // poses.csv only (tracked, degraded, predicted, lost); empty elsewhere
 };
 
 // Reads a pose CSV. The header must name the columns above (status optional). A malformed
