@@ -10,9 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/per_frame_scores.h"
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
 
+using epichead::testing::frame_successes;
 using epichead::testing::run_epichead;
 using epichead::testing::slurp;
 using epichead::testing::TempDir;
@@ -176,15 +178,11 @@ TEST_CASE("track finds the package again after a board hides it for a second (bo
   CHECK(scored["hidden_frames"] == 39);
   CHECK(scored["frames"] == 135 - 39);
   // Every frame after the board has gone (3.8 s, frame 108) plus the few to find it again.
-  std::ifstream per_frame(tmp / "per_frame.csv");
-  std::string line;
-  std::getline(per_frame, line);
   int after = 0, right_after = 0;
-  while (std::getline(per_frame, line)) {
-    const int frame = std::stoi(line);
+  for (const auto& [frame, success] : frame_successes(tmp / "per_frame.csv")) {
     if (frame < 115) continue;
     ++after;
-    right_after += line.find(',' + std::string("1,1,")) == line.find(',');  // frame,present,success,...
+    right_after += success;
   }
   CHECK(after == 20);
   CHECK(right_after >= 19);
@@ -221,15 +219,11 @@ TEST_CASE("track without the IMU rechecks a pose it re-locked after a loss, and 
   const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " +
                                            q(tmp / "per_frame.csv") + " --json");
   REQUIRE(score.exit_code == 0);
-  std::ifstream per_frame(tmp / "per_frame.csv");
-  std::string line;
-  std::getline(per_frame, line);
   int late = 0, late_ok = 0;
-  while (std::getline(per_frame, line)) {
-    const int frame = std::stoi(line);
+  for (const auto& [frame, success] : frame_successes(tmp / "per_frame.csv")) {
     if (frame < 44 || frame >= 52) continue;  // (the truth goes on to frame 99)
     ++late;
-    late_ok += line.find(',' + std::string("1,1,")) == line.find(',');  // frame,present,success,...
+    late_ok += success;
   }
   CHECK(late == 8);
   CHECK(late_ok == 8);
@@ -242,15 +236,8 @@ TEST_CASE("track without the IMU rechecks a pose it re-locked after a loss, and 
     INFO(r.err);
     REQUIRE(r.exit_code == 0);
     REQUIRE(run_epichead(tmp, "score " + q(seq) + " " + q(dir + "/poses.csv") + " --per-frame " + q(dir + "/f.csv")).exit_code == 0);
-    std::ifstream f(dir + "/f.csv");
-    std::string row;
-    std::getline(f, row);
-    int ok = 0;
-    while (std::getline(f, row)) {
-      const int frame = std::stoi(row);
-      if (frame >= 42 && frame <= 44) ok += row.find(',' + std::string("1,1,")) == row.find(',');
-    }
-    return ok;
+    const auto scored = frame_successes(dir + "/f.csv");
+    return scored.at(42) + scored.at(43) + scored.at(44);
   };
   CHECK(burst_ok("80") == 3);
   CHECK(burst_ok("40") < 3);

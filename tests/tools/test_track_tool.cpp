@@ -12,9 +12,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/per_frame_scores.h"
 #include "common/run_tool.h"
 #include "common/temp_dir.h"
 
+using epichead::testing::frame_successes;
 using epichead::testing::run_epichead;
 using epichead::testing::slurp;
 using epichead::testing::TempDir;
@@ -184,13 +186,11 @@ TEST_CASE("track --imu on gives frames vision loses the filter's propagation, st
     REQUIRE(r.exit_code == 0);
     REQUIRE(run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " + q(out + "/f.csv")).exit_code == 0);
     std::vector<Frame> frames(40);
-    std::ifstream poses(out + "/poses.csv"), scored(out + "/f.csv");
+    std::ifstream poses(out + "/poses.csv");
     std::string line;
     std::getline(poses, line);
     while (std::getline(poses, line)) frames.at(static_cast<std::size_t>(std::stoi(line))).status = line.substr(line.rfind(',') + 1);
-    std::getline(scored, line);
-    while (std::getline(scored, line))
-      frames.at(static_cast<std::size_t>(std::stoi(line))).success = line.find(',' + std::string("1,1,")) == line.find(',');
+    for (const auto& [frame, success] : frame_successes(out + "/f.csv")) frames.at(static_cast<std::size_t>(frame)).success = success;
     const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
     CHECK(report["lost"].get<int>() >= 2);
     return std::make_pair(frames, report["predicted_frames"].get<int>());
