@@ -4,19 +4,42 @@
 # pkg-config, each tracking the first frames of a sequence; then the installed program runs a
 # built-in scenario away from the source tree.
 # With the Python module built, it imports it from the prefix and tracks a frame.
-# Usage: tests/install/install_test.sh BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
+# With --deb the prefix is the Debian package's (`./dev package`: CPack) unpacked: its fields are
+# checked (version, the libraries section of deps/debian-packages.txt among its dependencies)
+# and its /usr is used as above. (Unpacked, not installed: installing needs root and would
+# change the machine the tests run on.)
+# Usage: tests/install/install_test.sh [--deb] BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
 #   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
 #   PYTHON_PRELOAD: LD_PRELOAD for python3 importing a sanitized module (the ASan runtime)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+deb=0
+if [[ "${1:-}" == --deb ]]; then deb=1; shift; fi
 build="$1" work="$2" seq="$3" flags="${4:-}" python_preload="${5:-}"
 rm -rf "$work"
 mkdir -p "$work"
 prefix="$work/prefix"
 step() { echo "install_test: $*"; }
 
-step "cmake --install $build --prefix $prefix"
-cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+if ((deb)); then
+  step "cpack -G DEB in $build, unpacked into $work/root"
+  (cd "$build" && cpack -G DEB -B "$work/package") > "$work/cpack.log" 2>&1 || { cat "$work/cpack.log" >&2; exit 1; }
+  package=$(compgen -G "$work/package/epichead_*.deb" | head -1 || true)
+  [[ -n "$package" ]] || { echo "install_test: cpack made no epichead_*.deb in $work/package" >&2; exit 1; }
+  dpkg-deb --field "$package" Package Version Depends > "$work/fields.txt"
+  grep -q '^Package: epichead$' "$work/fields.txt" || { echo "install_test: $package is not named epichead" >&2; exit 1; }
+  deb_version=$(sed -n 's/^Version: //p' "$work/fields.txt")
+  depends=$(sed -n 's/^Depends: //p' "$work/fields.txt")
+  # Every package of the libraries section is a dependency (the headers build against them).
+  for p in $(awk '/^# == /{section=$3} section=="libraries" && !/^#/ && NF {print $1}' "$here/../../deps/debian-packages.txt"); do
+    grep -qE "(^|, )$p( |,|\$)" <<< "$depends" || { echo "install_test: $package does not depend on $p (Depends: $depends)" >&2; exit 1; }
+  done
+  dpkg-deb -x "$package" "$work/root"
+  prefix="$work/root/usr"
+else
+  step "cmake --install $build --prefix $prefix"
+  cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+fi
 for f in bin/epichead include/epichead/vision/model_tracker.h share/doc/epichead/LICENSE; do
   [[ -e "$prefix/$f" ]] || { echo "install_test: $prefix/$f was not installed" >&2; exit 1; }
 done
@@ -31,6 +54,12 @@ cmake --build "$work/cmake-consumer" > "$work/consumer-build.log" 2>&1 || { cat 
 "$work/cmake-consumer/consumer" "$seq" 5
 
 step "a plain compile: pkg-config --cflags --libs epichead"
+if ((deb)); then
+  # The package's pkg-config file names /usr as its prefix: a copy names the unpacked root's.
+  mkdir -p "$work/pkgconfig"
+  sed "s|^prefix=.*|prefix=$prefix|" "$pc" > "$work/pkgconfig/epichead.pc"
+  pc="$work/pkgconfig/epichead.pc"
+fi
 export PKG_CONFIG_PATH="$(dirname "$pc")"
 # shellcheck disable=SC2046,SC2086
 # (pkg-config gives OpenCV's headers as -I, not -isystem: their warnings go to the log.)
@@ -62,4 +91,7 @@ program_version=$("$prefix/bin/epichead" --version)
   { echo "install_test: the program says '$program_version', pkg-config '$version'" >&2; exit 1; }
 "$prefix/bin/epichead" sim box_clutter --frames 2 --out "$work/sim" > /dev/null
 [[ -f "$work/sim/frames/000001.png" ]] || { echo "install_test: the installed program simulated no frames" >&2; exit 1; }
+if ((deb)); then
+  [[ "$deb_version" == "$version" ]] || { echo "install_test: the package says version '$deb_version', pkg-config '$version'" >&2; exit 1; }
+fi
 step "ok (version $version)"
