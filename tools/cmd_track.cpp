@@ -452,8 +452,9 @@ int run_track(const TrackArgs& args) {
   std::ofstream rep(report_path);
   rep << j.dump(1) << '\n';
   if (!rep.flush()) return fail(cmd, "cannot write " + report_path);
-  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost (%d of them predicted by the IMU); tracking %.3f ms median, %.3f ms p99\n", n,
-              args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, counts.predicted_frames,
+  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost (%d of them predicted by the IMU); "
+              "tracking %.3f ms median, %.3f ms p99\n",
+              n, args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, counts.predicted_frames,
               percentile(track_ms, 0.5), percentile(track_ms, 0.99));
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
               args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");
@@ -490,7 +491,8 @@ const CommandRegistration registration{
           ->check(CLI::Range(0.0, 10.0));
       app.add_option("--window-px", a->window_px,
                      "Samples across each model line's search window, px (default " + std::to_string(WindowOptions{}.width_px) +
-                         "): how far an edge may be from its predicted place; wider finds faster motion without the IMU, at more cost")
+                         "): how far an edge may be from its predicted place; wider follows faster motion but takes in more clutter and "
+                         "costs more (docs/detection.md)")
           ->check(CLI::Range(8, kMaxWindowWidth));
       app.add_option("--crease-deg", a->crease_deg, "Crease angle of the visibility test (default 20)")->check(CLI::Range(0.0, 180.0));
       app.add_option("--max-view-deg", a->max_view_deg,
