@@ -452,9 +452,10 @@ int run_track(const TrackArgs& args) {
   std::ofstream rep(report_path);
   rep << j.dump(1) << '\n';
   if (!rep.flush()) return fail(cmd, "cannot write " + report_path);
-  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost (%d of them predicted by the IMU); "
-              "tracking %.3f ms median, %.3f ms p99\n",
-              n, args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, counts.predicted_frames,
+  const std::string predicted =
+      args.imu == "on" ? " (" + std::to_string(counts.predicted_frames) + " of them predicted by the IMU)" : "";
+  std::printf("%zu frames (%s, imu %s): %d tracked, %d degraded, %d lost%s; tracking %.3f ms median, %.3f ms p99\n", n,
+              args.mode.c_str(), args.imu.c_str(), counts.tracked, counts.degraded, counts.lost, predicted.c_str(),
               percentile(track_ms, 0.5), percentile(track_ms, 0.99));
   std::printf("wrote %s, %s, %d overlays%s\n", poses_path.c_str(), report_path.c_str(), overlays.pngs(),
               args.video && overlays.video_note().empty() ? (" and " + overlays.video_path()).c_str() : "");
