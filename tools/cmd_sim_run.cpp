@@ -220,8 +220,8 @@ class TruthMeter {
 void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunArgs& a,
                    const std::vector<Eigen::Isometry3d>& symmetries, const std::optional<Eigen::Vector3d>& free_axis_obj,
                    RunMeasures& m) {
+  const auto truth = w.truth_at(f.exposure_t_s);
   if (a.soak) {
-    auto truth = w.truth_at(f.exposure_t_s);
     if (truth && m.errors_filled < m.errors.size()) {
       const auto angle_deg = [&](const Eigen::Isometry3d& p) {
         return Eigen::AngleAxisd(p.linear() * truth->cam_T_obj.linear().transpose()).angle() * 180 / M_PI;
@@ -236,12 +236,12 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
                                      lost ? std::nan("") : distance_mm(f.report->cam_T_obj)};
     }
   }
-  if (auto hidden = w.object_hidden_at(f.exposure_t_s); hidden && *hidden) {
+  if (truth && w.object_hidden(*truth)) {
     ++m.hidden;
     return;
   }
   if (f.status != vision::TrackStatus::Lost) {
-    if (auto truth = w.truth_at(f.exposure_t_s)) {
+    if (truth) {
       bool success = false;
       for (std::size_t k = 0; k <= symmetries.size() && !success; ++k) {
         Eigen::Isometry3d est = k == 0 ? f.report->cam_T_obj : f.report->cam_T_obj * symmetries[k - 1];

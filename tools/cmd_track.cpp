@@ -333,7 +333,7 @@ int run_track(const TrackArgs& args) {
   acquisition_options.use_imu_gravity = args.imu == "on";
   // With the IMU the prediction follows a burst, and a recheck's switch is then the likelier way
   // to a wrong pose (held-out mockup_walk 105: 100 -> 5 %, the detection's outline scored 1.5x
-  // the object's own, partly out of view); the rechecks after a degraded frame are for the
+  // the object's own, partly out of view); the rechecks after a doubtful frame are for the
   // constant-velocity prediction.
   acquisition_options.recheck.after_doubt = acquisition_options.recheck.after_doubt && args.imu == "off";
   TrackAcquisition acquisition(*seq, options, acquisition_options);

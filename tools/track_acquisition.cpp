@@ -10,7 +10,7 @@
 namespace epichead::tools {
 namespace {
 
-// --no-reacquire keeps the detected start's rechecks but starts none of its own after a degraded frame.
+// --no-reacquire keeps the detected start's rechecks but starts none of its own after a doubtful frame.
 RecheckOptions recheck_options(const AcquisitionOptions& o) {
   RecheckOptions r = o.recheck;
   r.after_doubt = r.after_doubt && o.reacquire;

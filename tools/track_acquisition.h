@@ -27,8 +27,8 @@ struct AcquisitionOptions {
   bool use_imu_gravity = false;      // gravity from imu.csv narrows the search (with --object-up)
   bool reacquire = true;             // detect after a loss (false: retry from the last pose only)
   int lost_frames_before_detection = 3;
-  // While a pose is provisional (recheck_schedule.h: found by detection, or after a degraded
-  // frame) the whole search runs again every so often, and a pose that explains a much longer
+  // While a pose is provisional (recheck_schedule.h: found by detection, or after a doubtful
+  // frame: degraded, or re-locked after a loss) the whole search runs again every so often, and a pose that explains a much longer
   // outline than the tracked one (score at least switch_ratio times) takes over. Clutter can hold
   // a box-like outline (a printed rectangle) before the object itself comes into view
   // (late_entry).
@@ -80,7 +80,7 @@ class TrackAcquisition {
   bool in_loss_ = false;
   RecheckSchedule rechecks_due_;
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
-  std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a degraded frame started
+  std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a doubtful frame started
   Eigen::Vector3d centre_obj_;  // vision::model_centre: levelled poses turn about it
   int levelled_ = 0;                                     // found poses levelled to gravity (geometry/level_to_up.h)
   int rechecks_ = 0, switches_ = 0;

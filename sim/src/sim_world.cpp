@@ -229,10 +229,8 @@ void SimWorld::deliver_to_nodes(const fw::CanFrame& frame, double t_s) {
   ++stats_.host_frames_ignored;
 }
 
-std::expected<bool, std::string> SimWorld::object_hidden_at(double t_s) {
-  auto truth = truth_at(t_s);
-  if (!truth) return std::unexpected(truth.error());
-  return occlusion_ && occlusion_->hides_object(t_s, truth->world_T_cam);
+bool SimWorld::object_hidden(const SimTruth& truth) {
+  return occlusion_ && occlusion_->hides_object(truth.t_s, truth.world_T_cam);
 }
 
 std::expected<SimTruth, std::string> SimWorld::truth_at(double t_s) const {

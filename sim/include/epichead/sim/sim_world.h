@@ -87,10 +87,10 @@ class SimWorld {
   // Ground truth at t_s in [now - history_s, now]; outside: an error saying the range.
   std::expected<SimTruth, std::string> truth_at(double t_s) const;
 
-  // Whether occluders (a cover board) hide the whole object at t_s, seen from the true camera
-  // then (occlusion_truth.h); t_s as for truth_at. False for a world built without a scene
-  // (CameraOutput::Blank with a given aim and no covers).
-  std::expected<bool, std::string> object_hidden_at(double t_s);
+  // Whether occluders (a cover board) hide the whole object at truth.t_s, seen from the true
+  // camera then (occlusion_truth.h; `truth` from truth_at). False for a world built without a
+  // scene (CameraOutput::Blank with a given aim and no covers).
+  bool object_hidden(const SimTruth& truth);
 
   const Scenario& scenario() const { return scenario_; }
   const vision::Camera& camera_model() const { return camera_model_; }
