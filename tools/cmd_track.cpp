@@ -27,6 +27,7 @@
 #include "command.h"
 #include "printable.h"
 #include "progress.h"
+#include "image_motion.h"
 #include "selected_lines.h"
 #include "track_acquisition.h"
 #include "track_prediction.h"
@@ -57,6 +58,7 @@ struct TrackArgs {
   std::string free_turn = "auto";
   bool settle = true;
   bool outline_colours = true;
+  std::string image_motion = "auto";  // follow the frame's own motion (tools/image_motion.h): auto = without the IMU
   std::uint32_t ransac_seed = RansacOptions{}.seed;
   AcquisitionOptions acquisition;
 };
@@ -273,6 +275,7 @@ struct TrackCounts {
   int predicted_frames = 0; // lost frames whose poses.csv row is the filter's propagation (--coast-s)
   int fallback_frames = 0;  // frames measured from the vision-only extrapolation
   int against_gravity = 0;  // tracked poses taken as lost: their tilt contradicts the accelerometer
+  int against_image_motion = 0;  // tracked poses that contradicted the frame's motion, measured again
 };
 
 // report.json's summary (per-frame entries and acquisition are added by the caller).
@@ -295,6 +298,7 @@ nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const Trac
   j["predicted_frames"] = c.predicted_frames;
   j["fallback_frames"] = c.fallback_frames;
   j["against_gravity_frames"] = c.against_gravity;
+  j["against_image_motion_frames"] = c.against_image_motion;
   if (tracker.free_turn()) {
     const auto& a = *tracker.free_turn();
     j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
@@ -310,6 +314,8 @@ int run_track(const TrackArgs& args) {
   const auto mode = modes.find(args.mode);
   if (mode == modes.end()) return fail(cmd, "--mode must be gradient, epic or epic+validation, got '" + args.mode + "'");
   if (args.imu != "on" && args.imu != "off") return fail(cmd, "--imu must be on or off, got '" + args.imu + "'");
+  if (args.image_motion != "auto" && args.image_motion != "on" && args.image_motion != "off")
+    return fail(cmd, "--image-motion must be auto, on or off, got '" + args.image_motion + "'");
   if (args.free_turn != "auto" && args.free_turn != "off") return fail(cmd, "--free-turn must be auto or off, got '" + args.free_turn + "'");
   auto seq = Sequence::open(args.seq);
   if (!seq) return fail(cmd, seq.error());
@@ -342,6 +348,10 @@ int run_track(const TrackArgs& args) {
   WindowImage image;
   FrameReport report;
   OverlayOutput overlays(args, *seq);
+  // Without the IMU, the frame's own motion: a burst the constant-velocity prediction misses,
+  // and a lock that contradicts it (tools/image_motion.h).
+  ImageMotion image_motion(seq->model(), seq->camera(), ImageMotionOptions{});
+  const bool use_image_motion = args.image_motion == "on" || (args.image_motion == "auto" && args.imu == "off");
 
   // Per frame and visible model edge, the candidate the tracker selected: what `epichead score
   // --lines` checks against the ground truth (did the tracker pick the right edge?).
@@ -376,8 +386,15 @@ int run_track(const TrackArgs& args) {
       std::printf("frame %d: object detected; tracking from here\n", entry.frame);
       predictor = std::move(*started);
     }
-    const Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
-    const std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
+    Eigen::Isometry3d predicted = (*predictor)->predict(entry.t_s);
+    std::optional<Eigen::Isometry3d> fallback = (*predictor)->fallback(entry.t_s);
+    if (use_image_motion) {
+      image_motion.measure(*frame);
+      if (const auto turned = image_motion.correct(predicted)) {
+        fallback = predicted;
+        predicted = *turned;
+      }
+    }
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
     // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
     // (a printed band, clutter), however well the image supports it: lost, so that detection runs.
@@ -386,10 +403,12 @@ int run_track(const TrackArgs& args) {
       report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
       ++counts.against_gravity;
     }
+    if (use_image_motion) counts.against_image_motion += image_motion.check(tracker, image, report);
     if (auto ok = acquisition.after_tracking(*frame, image, entry.t_s, predicted, tracker, **predictor, report); !ok)
       return fail(cmd, ok.error());
     counts.fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
+    if (use_image_motion) image_motion.tracked(report.status != TrackStatus::Lost ? std::optional(report.cam_T_obj) : std::nullopt);
     track_ms.push_back(report.times.total_ms);
     counts.tracked += report.status == TrackStatus::Tracked;
     counts.degraded += report.status == TrackStatus::Degraded;
@@ -424,6 +443,7 @@ int run_track(const TrackArgs& args) {
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
     if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));
+    if (use_image_motion) per_frame.back()["image_motion"] = image_motion.frame_json();
 
     write_selected_lines(lines_csv, tracker, report, entry.frame, selected);
 
@@ -446,6 +466,7 @@ int run_track(const TrackArgs& args) {
   nlohmann::json j = report_json(args, n, counts,
                                  track_ms, *predictor ? predictor->get() : nullptr, tracker);
   j["acquisition"] = acquisition.to_json();
+  if (use_image_motion) j["image_motion"] = image_motion.to_json();
   if (!overlays.video_note().empty()) j["video_note"] = overlays.video_note();
   j["per_frame"] = std::move(per_frame);
   const std::string report_path = (fs::path(args.out) / "report.json").string();
@@ -490,6 +511,10 @@ const CommandRegistration registration{
                      "With --imu on: a frame vision loses within this long of the filter's last vision pose gets the "
                      "filter's IMU propagation, status 'predicted' (default 0.2; 0: such frames are 'lost')")
           ->check(CLI::Range(0.0, 10.0));
+      app.add_option("--image-motion", a->image_motion,
+                     "on: the motion of the object's region since the previous frame (phase correlation) turns a prediction "
+                     "that misses a burst of camera motion, and a tracked pose that contradicts that motion is measured again; "
+                     "off: the prediction alone; auto (default): on without the IMU (docs/detection.md)");
       app.add_option("--window-px", a->window_px,
                      "Samples across each model line's search window, px (default " + std::to_string(WindowOptions{}.width_px) +
                          "): how far an edge may be from its predicted place; wider follows faster motion but takes in more clutter and "

@@ -120,6 +120,42 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   CHECK(fused["rotation_deg"]["p95"].get<double>() < 0.75 * vision["rotation_deg"]["p95"].get<double>());
 }
 
+TEST_CASE("track without the IMU follows a hand-held burst by the frame's own motion, which constant velocity misses") {
+  TempDir tmp("epichead_test_track_image_motion");
+  const std::string seq = tmp / "box_clutter";
+  // Development seed 6 of box_clutter (the first 50 frames of a 100-frame draw): a shake from
+  // frame 30 moves the package 20-40 px a frame. Detection is off, so each run shows what the
+  // prediction alone does.
+  REQUIRE(run_epichead(tmp, "sim box_clutter --seed 6 --out " + q(seq) + " --frames 100").exit_code == 0);
+  const auto successes = [&](const std::string& name, const std::string& flags) {
+    const std::string out = tmp / name;
+    const auto r = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --frames 50 --imu off --no-reacquire --every 0 --no-video" + flags);
+    INFO(r.out << r.err);
+    REQUIRE(r.exit_code == 0);
+    REQUIRE(run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " + q(out + "/f.csv")).exit_code == 0);
+    return frame_successes(out + "/f.csv");
+  };
+  const auto shake_ok = [](const auto& scored) {
+    int ok = 0;
+    for (int f = 30; f <= 36; ++f) ok += scored.at(f);
+    return ok;
+  };
+  // By default: every frame within the bounds, the prediction turned where it missed.
+  const auto followed = successes("image_motion", "");
+  int all_ok = 0;
+  for (const auto& [frame, success] : followed) all_ok += frame < 50 && success;
+  CHECK(all_ok == 50);
+  const auto report = nlohmann::json::parse(slurp(tmp / "image_motion/report.json"));
+  INFO(report["image_motion"].dump());
+  CHECK(report["lost"].get<int>() == 0);
+  CHECK(report["image_motion"]["measured_frames"].get<int>() == 49);  // every frame after the first
+  CHECK(report["image_motion"]["corrected_predictions"].get<int>() >= 3);
+  CHECK(report["per_frame"][31].contains("image_motion"));
+  // Constant velocity alone loses the package in the shake.
+  CHECK(shake_ok(successes("constant_velocity", " --image-motion off")) <= 3);
+  CHECK(shake_ok(followed) == 7);
+}
+
 TEST_CASE("track follows the real teabox video to within a few pixels of the hand-read corners") {
   TempDir tmp("epichead_test_track_tool");
   const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox", out = tmp / "teabox";
@@ -157,6 +193,9 @@ TEST_CASE("track rejects bad arguments with one line and a non-zero exit") {
   r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --imu-time-offset-s soon");
   CHECK(r.exit_code != 0);
   CHECK(r.err.find("'auto' or seconds") != std::string::npos);
+  r = run_epichead(tmp, "track " + q(data) + " --out " + q(tmp / "x") + " --image-motion sometimes");
+  CHECK(r.exit_code != 0);
+  CHECK(r.err.find("--image-motion must be auto, on or off") != std::string::npos);
   r = run_epichead(tmp, "track --help");
   CHECK(r.exit_code == 0);
   CHECK(r.out.find("--mode") != std::string::npos);

@@ -60,7 +60,8 @@ std::string to_string(TrackReason reasons) {
       {TrackReason::PoseFailed, "pose_failed"}, {TrackReason::FewInliers, "few_inliers"},
       {TrackReason::HighResidual, "high_residual"}, {TrackReason::Jump, "jump"},
       {TrackReason::Reacquired, "reacquired"},
-      {TrackReason::AgainstGravity, "against_gravity"}};
+      {TrackReason::AgainstGravity, "against_gravity"},
+      {TrackReason::AgainstImageMotion, "against_image_motion"}};
   std::string s;
   for (const auto& [bit, name] : names) {
     if (!has(reasons, bit)) continue;

@@ -49,6 +49,8 @@ enum class TrackReason : std::uint32_t {
   Reacquired = 1u << 6,      // tracked again after a loss (informational)
   AgainstGravity = 1u << 7,  // set by the caller with an IMU: the pose tilts the object away from
                              // the down the accelerometer measures (a wrong lock; fusion/learnt_gravity.h)
+  AgainstImageMotion = 1u << 8,  // set by the caller without an IMU: the pose puts the object away from
+                                 // where the frame's own motion shows it (a wrong lock; tools/image_motion.h)
 };
 constexpr TrackReason operator|(TrackReason a, TrackReason b) {
   return static_cast<TrackReason>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
