@@ -25,9 +25,9 @@
 #include <opencv2/videoio.hpp>
 
 #include "command.h"
+#include "image_motion.h"
 #include "printable.h"
 #include "progress.h"
-#include "image_motion.h"
 #include "selected_lines.h"
 #include "track_acquisition.h"
 #include "track_prediction.h"
