@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "epichead/vision/model_centre.h"
+#include "epichead/vision/pose_estimator.h"
 
 namespace epichead::tools {
 
@@ -94,13 +95,18 @@ bool ImageMotion::check(vision::ModelTracker& tracker, const vision::WindowImage
   if (!seen_px_ || report.status == TrackStatus::Lost || !disagrees(report.cam_T_obj, "tracked_gap_px")) return false;
   ++disagreed_;
   const Eigen::Isometry3d from = *seen();
+  const vision::StageTimes first = report.times;  // the frame's time is both measurements'
   tracker.reset();
   tracker.track(image, from, report);
+  report.times.add_stages(first);
+  report.times.total_ms += first.total_ms;
   if (report.status == TrackStatus::Lost || disagrees(report.cam_T_obj, "remeasured_gap_px")) {
     // Nothing the image supports lies where it shows the object (a blurred frame): the turn it
-    // measured is the estimate, and the tracker starts the next frame afresh from it.
+    // measured is the estimate, as loose as a start's, and the tracker starts the next frame
+    // afresh from it.
     tracker.reset();
     report.cam_T_obj = from;
+    report.covariance = vision::initial_pose_covariance();
     ++replaced_;
     frame_["replaced"] = true;
   }
@@ -114,8 +120,12 @@ nlohmann::json ImageMotion::to_json() const {
   std::vector<double> ms = ms_;
   std::sort(ms.begin(), ms.end());
   const auto at = [&](double q) { return ms.empty() ? 0.0 : ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1))]; };
-  return {{"ms_median", at(0.5)}, {"ms_p99", at(0.99)}, {"measured_frames", measured_}, {"corrected_predictions", corrected_}, {"disagreeing_locks", disagreed_},
-          {"replaced_by_image_motion", replaced_}};
+  return {{"measured_frames", measured_},
+          {"corrected_predictions", corrected_},
+          {"disagreeing_locks", disagreed_},
+          {"replaced_by_image_motion", replaced_},
+          {"ms_median", at(0.5)},
+          {"ms_p99", at(0.99)}};
 }
 
 }  // namespace epichead::tools
