@@ -26,6 +26,7 @@
 
 #include "command.h"
 #include "image_motion.h"
+#include "percentile.h"
 #include "printable.h"
 #include "progress.h"
 #include "selected_lines.h"
@@ -120,13 +121,6 @@ void draw_frame(cv::Mat& canvas, const ModelTracker& tracker, const FrameReport&
                 to_string(report.reasons).c_str(), report.found, report.visible, report.inliers, report.times.total_ms);
   cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 3, cv::LINE_AA);
   cv::putText(canvas, caption, {8, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {255, 255, 255}, 1, cv::LINE_AA);
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
 }
 
 // report.json's entry for one frame: status, stage times and feature counts.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "percentile.h"
 #include "epichead/vision/model_centre.h"
 #include "epichead/vision/pose_estimator.h"
 
@@ -117,15 +118,12 @@ bool ImageMotion::check(vision::ModelTracker& tracker, const vision::WindowImage
 }
 
 nlohmann::json ImageMotion::to_json() const {
-  std::vector<double> ms = ms_;
-  std::sort(ms.begin(), ms.end());
-  const auto at = [&](double q) { return ms.empty() ? 0.0 : ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1))]; };
   return {{"measured_frames", measured_},
           {"corrected_predictions", corrected_},
           {"disagreeing_locks", disagreed_},
           {"replaced_by_image_motion", replaced_},
-          {"ms_median", at(0.5)},
-          {"ms_p99", at(0.99)}};
+          {"ms_median", percentile(ms_, 0.5)},
+          {"ms_p99", percentile(ms_, 0.99)}};
 }
 
 }  // namespace epichead::tools

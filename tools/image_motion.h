@@ -39,8 +39,6 @@ class ImageMotion {
   // Before tracking a frame: correlates the region of the model at the last pose given to
   // tracked() with this frame (nothing is measured after a lost frame).
   void measure(const cv::Mat& frame);
-  // The previous pose turned so that the object's centre lies where the image shows it.
-  std::optional<Eigen::Isometry3d> seen() const;
   // `predicted` turned to where the image shows the object, when they disagree by more than
   // predict_gap_px; otherwise nothing (the prediction stands).
   std::optional<Eigen::Isometry3d> correct(const Eigen::Isometry3d& predicted);
@@ -56,6 +54,8 @@ class ImageMotion {
   const nlohmann::json& frame_json() const { return frame_; }
 
  private:
+  // The previous pose turned so that the object's centre lies where the image shows it.
+  std::optional<Eigen::Isometry3d> seen() const;
   std::optional<cv::Rect> region_at(const Eigen::Isometry3d& cam_T_obj) const;
   std::optional<Eigen::Vector2d> centre_px(const Eigen::Isometry3d& cam_T_obj) const;
   Eigen::Isometry3d turned(const Eigen::Isometry3d& cam_T_obj, const Eigen::Vector2d& from_px) const;
