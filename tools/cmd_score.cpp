@@ -10,6 +10,7 @@
 #include <expected>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -77,14 +78,29 @@ std::string number_or_empty(double v) {
   return buf;
 }
 
-std::expected<void, std::string> write_per_frame(const std::string& path, const ScoreSummary& summary) {
+// With covariances, also each scored frame's NEES (empty where not counted). The error twist
+// (truth = exp(error) * estimate, camera frame, metres and radians) says which way a frame is off.
+std::expected<void, std::string> write_per_frame(const std::string& path, const ScoreSummary& summary,
+                                                 const std::optional<vision::PoseConsistency>& consistency) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return std::unexpected(path + ": cannot open for writing");
-  std::fprintf(f, "frame,present,success,rotation_deg,translation_mm,reprojection_px\n");
-  for (const auto& s : summary.per_frame)
-    std::fprintf(f, "%d,%d,%d,%s,%s,%s\n", s.frame, s.present ? 1 : 0, s.success ? 1 : 0,
+  std::map<int, double> nees;
+  if (consistency)
+    for (const auto& v : consistency->per_frame) nees[v.frame] = v.nees;
+  std::fprintf(f, "frame,present,success,rotation_deg,translation_mm,reprojection_px,"
+                  "err_tx_m,err_ty_m,err_tz_m,err_rx_rad,err_ry_rad,err_rz_rad%s\n",
+               consistency ? ",nees" : "");
+  for (const auto& s : summary.per_frame) {
+    std::fprintf(f, "%d,%d,%d,%s,%s,%s", s.frame, s.present ? 1 : 0, s.success ? 1 : 0,
                  number_or_empty(s.rotation_deg).c_str(), number_or_empty(s.translation_mm).c_str(),
                  number_or_empty(s.reprojection_px).c_str());
+    for (int i = 0; i < 6; ++i) std::fprintf(f, ",%s", number_or_empty(s.error_twist[i]).c_str());
+    if (consistency) {
+      const auto it = nees.find(s.frame);
+      std::fprintf(f, ",%s", it == nees.end() ? "" : number_or_empty(it->second).c_str());
+    }
+    std::fprintf(f, "\n");
+  }
   if (std::fclose(f) != 0) return std::unexpected(path + ": write error");
   return {};
 }
@@ -190,7 +206,9 @@ const CommandRegistration registration{
                    "Score up to the model's own symmetries (turns that map its points onto its points, e.g. a box's half "
                    "turns): a pose found without a start (detect) may be any of them");
       app.add_option("--per-frame", *per_frame,
-                     "Write frame,present,success,rotation_deg,translation_mm,reprojection_px to this CSV");
+                     "Write frame,present,success,rotation_deg,translation_mm,reprojection_px, the error twist "
+                     "(err_tx_m..err_rz_rad: truth = exp(err) * estimate, camera frame) and, with --covariance, "
+                     "nees to this CSV");
       app.add_option("--reference", *reference,
                      "Compare with these poses instead of gt.csv (e.g. another tracker's reference_visp.csv)");
       app.add_option("--lines", *lines,
@@ -262,10 +280,12 @@ const CommandRegistration registration{
           line_json = to_json(*ls);
         }
         nlohmann::json consistency_json = nullptr;
+        std::optional<vision::PoseConsistency> consistency;
         if (!covariance->empty()) {
           auto covs = vision::read_pose_covariance_csv(*covariance);
           if (!covs) return fail("score", covs.error());
-          consistency_json = to_json(vision::pose_consistency(summary, *covs));
+          consistency = vision::pose_consistency(summary, *covs);
+          consistency_json = to_json(*consistency);
         }
         std::set<int> truth_frames;
         for (const auto& g : truth_poses) truth_frames.insert(g.frame);
@@ -273,7 +293,7 @@ const CommandRegistration registration{
         for (const auto& e : *estimates) ignored += truth_frames.count(e.frame) == 0 && hidden.count(e.frame) == 0;
 
         if (!per_frame->empty()) {
-          if (auto written = write_per_frame(*per_frame, summary); !written) return fail("score", written.error());
+          if (auto written = write_per_frame(*per_frame, summary, consistency); !written) return fail("score", written.error());
         }
         if (*json) {
           const nlohmann::json j{{"frames", summary.frames},

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "epichead/vision/offline/pose_covariance_csv.h"
 #include "epichead/vision/offline/sequence.h"
 #include "epichead/vision/offline/stamped_pose.h"
 #include "epichead/vision/visibility.h"
@@ -125,13 +126,45 @@ TEST_CASE("score --per-frame writes one row per ground-truth frame") {
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   REQUIRE(lines.size() == kFrames + 1);
-  CHECK(lines[0] == "frame,present,success,rotation_deg,translation_mm,reprojection_px");
-  CHECK(lines[3] == "2,0,0,,,");
-  CHECK_THAT(lines[1], Catch::StartsWith("0,1,1,") && Catch::Contains(",20.000000,"));
+  CHECK(lines[0] ==
+        "frame,present,success,rotation_deg,translation_mm,reprojection_px,err_tx_m,err_ty_m,err_tz_m,err_rx_rad,"
+        "err_ry_rad,err_rz_rad");
+  CHECK(lines[3] == "2,0,0,,,,,,,,,");
+  // 20 mm off along x: truth = exp(err) * estimate moves it back.
+  CHECK_THAT(lines[1], Catch::StartsWith("0,1,1,") && Catch::Contains(",20.000000,") && Catch::Contains(",-0.020000,"));
 
   const Run bad = score(tmp, q(seq) + " " + q(make_estimates(tmp)) + " --per-frame " + q(tmp / "no/such/dir.csv"));
   CHECK(bad.exit_code == 1);
   CHECK(one_line(bad.err, "epichead score: "));
+}
+
+TEST_CASE("score --per-frame with --covariance gives each scored frame's NEES") {
+  TempDir tmp;
+  const std::string seq = make_sequence(tmp);
+  // 10 mm and 1 mrad sigmas: the 20 mm error along x is two sigmas, NEES 4.
+  std::vector<StampedCovariance> covs;
+  for (int i = 0; i < kFrames; ++i) {
+    if (i == 2) continue;
+    StampedCovariance c;
+    c.frame = i;
+    c.t_s = i / 30.0;
+    c.covariance.setZero();
+    c.covariance.diagonal() << 1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6;
+    covs.push_back(c);
+  }
+  REQUIRE(write_pose_covariance_csv(tmp / "cov.csv", covs).has_value());
+  const Run r = score(tmp, q(seq) + " " + q(make_estimates(tmp)) + " --json --covariance " + q(tmp / "cov.csv") +
+                               " --per-frame " + q(tmp / "per_frame.csv"));
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(nlohmann::json::parse(r.out).at("covariance_consistency").at("mean").get<double>() == Approx(4.0).epsilon(1e-3));
+  std::ifstream in(tmp / "per_frame.csv");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  REQUIRE(lines.size() == kFrames + 1);
+  CHECK_THAT(lines[0], Catch::EndsWith(",err_rz_rad,nees"));
+  CHECK_THAT(lines[1], Catch::EndsWith(",4.000000"));
+  CHECK_THAT(lines[3], Catch::StartsWith("2,0,0,") && Catch::EndsWith(","));
 }
 
 TEST_CASE("score --sym-axis removes the turn about the given axis") {

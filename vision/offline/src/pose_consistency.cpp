@@ -51,15 +51,17 @@ PoseConsistency pose_consistency(const ScoreSummary& summary, const std::vector<
   const Chi2Bounds b = bounds(dof);
   std::unordered_map<int, const StampedCovariance*> by_frame;
   for (const auto& c : covariances) by_frame.emplace(c.frame, &c);
+  PoseConsistency out;
   std::vector<double> nees_values;
   for (const FrameScore& s : summary.per_frame) {
     if (!s.success || !s.error_twist.allFinite()) continue;
     const auto it = by_frame.find(s.frame);
     if (it == by_frame.end()) continue;
     const double v = nees(s, it->second->covariance);
-    if (std::isfinite(v)) nees_values.push_back(v);
+    if (!std::isfinite(v)) continue;
+    nees_values.push_back(v);
+    out.per_frame.push_back({s.frame, v});
   }
-  PoseConsistency out;
   out.dof = dof;
   out.count = static_cast<int>(nees_values.size());
   if (nees_values.empty()) {

@@ -21,6 +21,12 @@ struct PoseConsistency {
   double within_95pct = 0;     // between the two: 0.95 when honest
   // The factor the covariances would need to be scaled by for a mean NEES of dof.
   double scale_for_mean = 0;
+  // Each counted frame's NEES, in frame order (score --per-frame writes them).
+  struct FrameNees {
+    int frame = 0;
+    double nees = 0;
+  };
+  std::vector<FrameNees> per_frame;
 };
 
 // 6 degrees of freedom, or 5 when the summary was scored with a symmetry axis (score_poses'
