@@ -194,7 +194,10 @@ bool EllipseTracker::placed_shape(const EllipseFeature& f, const Ellipse& e) con
 
 bool EllipseTracker::plausible(const EllipseFeature& f, const Ellipse& e) const {
   // The new contour must cross every arc line inside its window: an ellipse fitted to a short
-  // arc can otherwise swing far from where any line looked (it has no support there).
+  // arc can otherwise swing far from where any line looked (it has no support there). The
+  // Sampson distance overstates the distance near a flat ellipse's major axis, which refuses a
+  // flat rim's candidates moved across it by more than about its semi-minor axis; the exact
+  // distance was tried and lost runs to printed bands beside the rims (docs/epic.md).
   const double half = 0.5 * (window_.width_px() - 1);
   const Conic k = e.conic();
   for (int r = f.arc_row_begin; r < f.arc_row_end; ++r) {
