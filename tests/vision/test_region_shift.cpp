@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "epichead/common/allocation_counter.h"
 #include "epichead/vision/region_shift.h"
 
 using namespace epichead::vision;
@@ -65,4 +66,20 @@ TEST_CASE("region shift: nothing for a region too small, a new frame size, an un
   estimator.reset();
   CHECK_FALSE(estimator.push(view(world, 5, 5), cv::Rect(0, 0, 200, 200)).has_value());
   CHECK(estimator.push(view(world, 5, 9), cv::Rect(100, 100, 200, 200)).has_value());
+}
+
+TEST_CASE("region shift: after the first frames of a size, measuring allocates nothing", "[alloc]") {
+  // Regions of several sizes (the object's region follows its pose), one frame size.
+  const cv::Mat world = scene(5);
+  const cv::Mat a = view(world, 40, 30), b = view(world, 52, 21);
+  RegionShiftEstimator estimator;
+  (void)estimator.push(a, cv::Rect(200, 150, 240, 180));
+  (void)estimator.push(b, cv::Rect(200, 150, 240, 180));
+  int measured = 0;
+  const auto before = epichead::common::allocation_count();
+  for (int i = 0; i < 20; ++i)
+    measured += estimator.push(i % 2 ? a : b, cv::Rect(100 + 7 * i, 80 + 3 * i, 120 + 9 * i, 90 + 11 * i)).has_value();
+  const auto after = epichead::common::allocation_count();  // before any assertion: Catch allocates
+  CHECK(measured == 20);
+  CHECK(after - before == 0);
 }

@@ -1,30 +1,56 @@
 #include "epichead/vision/region_shift.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 
+#include <opencv2/core/hal/hal.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace epichead::vision {
 namespace {
-// Correlated at half resolution, the region is at least this many (halved) pixels a side, and
-// a larger region is shrunk further to at most kMaxSidePx a side: the DFT's cost grows with the
-// area, and a shift needs a pixel or two of precision, not the frame's.
-constexpr int kMinSidePx = 16;
-constexpr int kMaxSidePx = 128;
+// The region is correlated at a fixed kSidePx x kSidePx (each axis scaled on its own): one size
+// means one DFT plan and buffers made once, and a shift needs a pixel or two of precision, not
+// the frame's. A region under kMinSidePx a side is too small to correlate.
+constexpr int kSidePx = 64;
+constexpr int kMinSidePx = 32;
 
-// The region of an 8-bit frame as grey floats, resized to `size` (about half the region's, a
-// size the FFT is fast at), weighted by `window`: scratch in `grey` and `full`, result in `out`.
-void prepare(const cv::Mat& frame, const cv::Rect& region, const cv::Size& size, const cv::Mat& window, cv::Mat& grey,
-             cv::Mat& full, cv::Mat& out) {
-  const cv::Mat crop = frame(region);
-  if (frame.channels() == 3) cv::cvtColor(crop, grey, cv::COLOR_BGR2GRAY);
-  else if (frame.channels() == 4) cv::cvtColor(crop, grey, cv::COLOR_BGRA2GRAY);
-  else crop.copyTo(grey);
-  grey.convertTo(full, CV_32F);
-  cv::resize(full, out, size, 0, 0, cv::INTER_AREA);
-  cv::multiply(out, window, out);
+// The mean grey (BT.601 weights on B, G, R) of each of the kSidePx x kSidePx boxes that tile the
+// region, times `window`, into `out`: what cv::resize's INTER_AREA and a grey conversion give, up
+// to rounding, without the tables cv::resize allocates on every call. `columns` holds one row of
+// grey sums across the region (the frame's width).
+void shrink_grey(const cv::Mat& frame, const cv::Rect& region, const cv::Mat& window, std::vector<float>& columns,
+                 cv::Mat& out) {
+  std::array<int, kSidePx + 1> xs, ys;
+  for (int i = 0; i <= kSidePx; ++i) {
+    xs[static_cast<std::size_t>(i)] = i * region.width / kSidePx;
+    ys[static_cast<std::size_t>(i)] = region.y + i * region.height / kSidePx;
+  }
+  const int channels = frame.channels(), width = region.width;
+  float* sums = columns.data();
+  for (int j = 0; j < kSidePx; ++j) {
+    // A region narrower than kSidePx repeats its pixels (a box at least one pixel wide).
+    const int y0 = ys[static_cast<std::size_t>(j)], y1 = std::max(ys[static_cast<std::size_t>(j) + 1], y0 + 1);
+    std::fill(sums, sums + width, 0.0f);
+    for (int y = y0; y < y1; ++y) {
+      const std::uint8_t* p = frame.ptr<std::uint8_t>(y) + static_cast<std::ptrdiff_t>(region.x) * channels;
+      if (channels == 1) {
+        for (int x = 0; x < width; ++x) sums[x] += p[x];
+      } else {
+        for (int x = 0; x < width; ++x)
+          sums[x] += 0.114f * p[x * channels] + 0.587f * p[x * channels + 1] + 0.299f * p[x * channels + 2];
+      }
+    }
+    float* o = out.ptr<float>(j);
+    const float* w = window.ptr<float>(j);
+    for (int i = 0; i < kSidePx; ++i) {
+      const int x0 = xs[static_cast<std::size_t>(i)], x1 = std::max(xs[static_cast<std::size_t>(i) + 1], x0 + 1);
+      float sum = 0;
+      for (int x = x0; x < x1; ++x) sum += sums[x];
+      o[i] = w[i] * sum / static_cast<float>((x1 - x0) * (y1 - y0));
+    }
+  }
 }
 
 // Sub-pixel place of the peak along one axis from its neighbours (a parabola through three).
@@ -36,6 +62,20 @@ double parabola_offset(float left, float centre, float right) {
 }
 }  // namespace
 
+RegionShiftEstimator::RegionShiftEstimator()
+    : a_(kSidePx, kSidePx, CV_32F),
+      b_(kSidePx, kSidePx, CV_32F),
+      spectrum_a_(kSidePx, kSidePx, CV_32FC2),
+      spectrum_b_(kSidePx, kSidePx, CV_32FC2),
+      cross_(kSidePx, kSidePx, CV_32FC2),
+      surface_(kSidePx, kSidePx, CV_32F),
+      // OpenCV's DFT planned once for the one size: cv::dft plans on every call (seven
+      // allocations each), its HAL object reuses the plan and allocates nothing.
+      forward_(cv::hal::DFT2D::create(kSidePx, kSidePx, CV_32F, 1, 2, cv::DFT_COMPLEX_OUTPUT)),
+      inverse_(cv::hal::DFT2D::create(kSidePx, kSidePx, CV_32F, 2, 1, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT)) {
+  cv::createHanningWindow(window_, cv::Size(kSidePx, kSidePx), CV_32F);
+}
+
 std::optional<RegionShift> RegionShiftEstimator::push(const cv::Mat& frame, const cv::Rect& region_px) {
   const int channels = frame.channels();
   if (frame.empty() || frame.depth() != CV_8U || (channels != 1 && channels != 3 && channels != 4)) return std::nullopt;
@@ -43,17 +83,12 @@ std::optional<RegionShift> RegionShiftEstimator::push(const cv::Mat& frame, cons
   const bool comparable = have_previous_ && previous_.size() == frame.size() && previous_.type() == frame.type();
   const cv::Rect region = region_px & cv::Rect(0, 0, frame.cols, frame.rows);
   // Only the region is converted and correlated: a frame's worth of work would cost several
-  // tracking steps. OpenCV's phaseCorrelate does the same sums but took 1-2 ms here against
-  // 0.2 ms for these steps on buffers kept from frame to frame.
-  if (comparable && region.width / 2 >= kMinSidePx && region.height / 2 >= kMinSidePx) {
-    const double halve = std::max(2.0, std::max(region.width, region.height) / static_cast<double>(kMaxSidePx));
-    const cv::Size size(cv::getOptimalDFTSize(static_cast<int>(region.width / halve)),
-                        cv::getOptimalDFTSize(static_cast<int>(region.height / halve)));
-    if (window_.size() != size) cv::createHanningWindow(window_, size, CV_32F);
-    prepare(previous_, region, size, window_, grey_, full_, a_);
-    prepare(frame, region, size, window_, grey_, full_, b_);
-    cv::dft(a_, spectrum_a_, cv::DFT_COMPLEX_OUTPUT);
-    cv::dft(b_, spectrum_b_, cv::DFT_COMPLEX_OUTPUT);
+  // tracking steps. OpenCV's phaseCorrelate does the same sums but took 1-2 ms here.
+  if (comparable && region.width >= kMinSidePx && region.height >= kMinSidePx) {
+    shrink_grey(previous_, region, window_, columns_, a_);
+    shrink_grey(frame, region, window_, columns_, b_);
+    forward_->apply(a_.data, a_.step, spectrum_a_.data, spectrum_a_.step);
+    forward_->apply(b_.data, b_.step, spectrum_b_.data, spectrum_b_.step);
     // The normalised cross-power spectrum B conj(A) / |B conj(A)|: its inverse is a peak at the
     // shift of b against a (where a's content went), as high as the share of the region that
     // moved as one.
@@ -65,7 +100,7 @@ std::optional<RegionShift> RegionShiftEstimator::push(const cv::Mat& frame, cons
         c[x] = m > 1e-12f ? c[x] / m : std::complex<float>(0, 0);
       }
     }
-    cv::idft(cross_, surface_, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+    inverse_->apply(cross_.data, cross_.step, surface_.data, surface_.step);
     cv::Point peak;
     double peak_value = 0;
     cv::minMaxLoc(surface_, nullptr, &peak_value, nullptr, &peak);
@@ -79,6 +114,7 @@ std::optional<RegionShift> RegionShiftEstimator::push(const cv::Mat& frame, cons
     out = RegionShift{Eigen::Vector2d(dx * scale_x, dy * scale_y), peak_value};
   }
   frame.copyTo(previous_);  // into the same buffer each frame of one size
+  if (static_cast<int>(columns_.size()) < frame.cols) columns_.resize(static_cast<std::size_t>(frame.cols));
   have_previous_ = true;
   return out;
 }
