@@ -16,10 +16,22 @@ namespace {
 constexpr int kSidePx = 64;
 constexpr int kMinSidePx = 32;
 
-// The mean grey (BT.601 weights on B, G, R) of each of the kSidePx x kSidePx boxes that tile the
-// region, times `window`, into `out`: what cv::resize's INTER_AREA and a grey conversion give, up
-// to rounding, without the tables cv::resize allocates on every call. `columns` holds one row of
-// grey sums across the region (the frame's width).
+// One source row's grey values added to `sums` (the region's width): B, G, R weighted as BT.601,
+// with the channel count fixed so that the compiler vectorises the loop.
+template <int Channels>
+void add_grey_row(const std::uint8_t* p, int width, float* sums) {
+  if constexpr (Channels == 1) {
+    for (int x = 0; x < width; ++x) sums[x] += p[x];
+  } else {
+    for (int x = 0; x < width; ++x)
+      sums[x] += 0.114f * p[x * Channels] + 0.587f * p[x * Channels + 1] + 0.299f * p[x * Channels + 2];
+  }
+}
+
+// The mean grey of each of the kSidePx x kSidePx boxes that tile the region, times `window`,
+// into `out`: what cv::resize's INTER_AREA and a grey conversion give, up to rounding, without
+// the tables cv::resize allocates on every call. `columns` holds one row of grey sums across the
+// region (the frame's width).
 void shrink_grey(const cv::Mat& frame, const cv::Rect& region, const cv::Mat& window, std::vector<float>& columns,
                  cv::Mat& out) {
   std::array<int, kSidePx + 1> xs, ys;
@@ -35,12 +47,9 @@ void shrink_grey(const cv::Mat& frame, const cv::Rect& region, const cv::Mat& wi
     std::fill(sums, sums + width, 0.0f);
     for (int y = y0; y < y1; ++y) {
       const std::uint8_t* p = frame.ptr<std::uint8_t>(y) + static_cast<std::ptrdiff_t>(region.x) * channels;
-      if (channels == 1) {
-        for (int x = 0; x < width; ++x) sums[x] += p[x];
-      } else {
-        for (int x = 0; x < width; ++x)
-          sums[x] += 0.114f * p[x * channels] + 0.587f * p[x * channels + 1] + 0.299f * p[x * channels + 2];
-      }
+      if (channels == 3) add_grey_row<3>(p, width, sums);
+      else if (channels == 4) add_grey_row<4>(p, width, sums);
+      else add_grey_row<1>(p, width, sums);
     }
     float* o = out.ptr<float>(j);
     const float* w = window.ptr<float>(j);
