@@ -6,8 +6,9 @@
 # With the Python module built, it imports it from the prefix and tracks a frame.
 # With --deb the prefix is the Debian package's (`./dev package`: CPack) unpacked: its fields are
 # checked (version, the libraries section of deps/debian-packages.txt among its dependencies)
-# and its /usr is used as above. (Unpacked, not installed: installing needs root and would
-# change the machine the tests run on.)
+# and its /usr is used as above, and apt simulates installing it (`apt-get install --simulate`:
+# it resolves the Depends against the machine's package lists and changes nothing). (Unpacked,
+# not installed: installing needs root and would change the machine the tests run on.)
 # Usage: tests/install/install_test.sh [--deb] BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
 #   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
 #   PYTHON_PRELOAD: LD_PRELOAD for python3 importing a sanitized module (the ASan runtime)
@@ -34,6 +35,16 @@ if ((deb)); then
   for p in $(awk '/^# == /{section=$3} section=="libraries" && !/^#/ && NF {print $1}' "$here/../../deps/debian-packages.txt"); do
     grep -qE "(^|, )$p( |,|\$)" <<< "$depends" || { echo "install_test: $package does not depend on $p (Depends: $depends)" >&2; exit 1; }
   done
+  if command -v apt-get > /dev/null; then
+    step "apt-get install --simulate $(basename "$package")"
+    # Unmet or misspelt dependencies make apt refuse (exit 100) and name them.
+    apt-get install --simulate -q "$package" > "$work/apt-simulate.log" 2>&1 ||
+      { cat "$work/apt-simulate.log" >&2; echo "install_test: apt would not install $package" >&2; exit 1; }
+    grep -q '^Inst epichead ' "$work/apt-simulate.log" ||
+      { cat "$work/apt-simulate.log" >&2; echo "install_test: apt's simulation installs no epichead" >&2; exit 1; }
+  else
+    step "no apt-get on this machine: the package's installation is not simulated"
+  fi
   dpkg-deb -x "$package" "$work/root"
   prefix="$work/root/usr"
 else
