@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <cstdint>
+#include <vector>
 
 #include <opencv2/core/hal/hal.hpp>
 #include <opencv2/imgproc.hpp>
