@@ -24,6 +24,11 @@ struct RegionShift {
 class RegionShiftEstimator {
  public:
   RegionShiftEstimator();
+  // Not copyable: a copy would share the DFT's plan, whose work buffers are not for two threads.
+  RegionShiftEstimator(const RegionShiftEstimator&) = delete;
+  RegionShiftEstimator& operator=(const RegionShiftEstimator&) = delete;
+  RegionShiftEstimator(RegionShiftEstimator&&) = default;
+  RegionShiftEstimator& operator=(RegionShiftEstimator&&) = default;
   // Keeps the frame (8-bit, 1, 3 or 4 channels) as the next call's previous frame, and returns
   // the shift of `region_px` (a rectangle of the previous frame) since the previous frame:
   // nothing for the first frame, a frame of another size, or a region too small to correlate.
