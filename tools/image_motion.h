@@ -70,7 +70,7 @@ class ImageMotion {
   std::optional<Eigen::Isometry3d> previous_;
   std::optional<Eigen::Vector2d> seen_px_;  // this frame: where the image shows the object's centre
   nlohmann::json frame_;
-  std::vector<double> ms_;  // per measured frame: the correlation's time (frame to grey, halved, FFTs)
+  std::vector<double> ms_;  // per measured frame: the correlation's time (shrink to grey, DFTs)
   int measured_ = 0, corrected_ = 0, disagreed_ = 0, replaced_ = 0;
 };
 

@@ -59,7 +59,7 @@ TEST_CASE("region shift: nothing for a region too small, a new frame size, an un
   const cv::Mat world = scene(3);
   RegionShiftEstimator estimator;
   (void)estimator.push(view(world, 0, 0), cv::Rect(0, 0, 10, 10));
-  CHECK_FALSE(estimator.push(view(world, 5, 5), cv::Rect(100, 100, 20, 20)).has_value());   // 10x10 halved pixels
+  CHECK_FALSE(estimator.push(view(world, 5, 5), cv::Rect(100, 100, 20, 20)).has_value());   // under 32 px a side
   CHECK_FALSE(estimator.push(world(cv::Rect(0, 0, 320, 240)).clone(), cv::Rect(0, 0, 200, 200)).has_value());  // other size
   CHECK_FALSE(estimator.push(cv::Mat(480, 640, CV_32FC1, cv::Scalar(0)), cv::Rect(0, 0, 200, 200)).has_value());
   (void)estimator.push(view(world, 0, 0), cv::Rect(0, 0, 200, 200));
