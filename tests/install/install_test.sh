@@ -9,13 +9,24 @@
 # and its /usr is used as above, and apt simulates installing it (`apt-get install --simulate`:
 # it resolves the Depends against the machine's package lists and changes nothing). (Unpacked,
 # not installed: installing needs root and would change the machine the tests run on.)
-# Usage: tests/install/install_test.sh [--deb] BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
+# With --system (root, on a machine you may change: a container, a VM, a fresh install) the
+# package is installed for real with apt-get, the checks run against /usr, and it is purged at
+# the end. It refuses to run when epichead is already installed. Not part of ./dev test.
+# Usage: tests/install/install_test.sh [--deb|--system] BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
 #   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
 #   PYTHON_PRELOAD: LD_PRELOAD for python3 importing a sanitized module (the ASan runtime)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-deb=0
+deb=0 system=0
 if [[ "${1:-}" == --deb ]]; then deb=1; shift; fi
+if [[ "${1:-}" == --system ]]; then deb=1 system=1; shift; fi
+if ((system)); then
+  [[ $(id -u) == 0 ]] || { echo "install_test: --system installs the package with apt-get: run it as root" >&2; exit 1; }
+  if dpkg-query -W -f='${Status}' epichead 2>/dev/null | grep -q 'install ok installed'; then
+    echo "install_test: --system: epichead is already installed here; remove it first (apt-get purge epichead)" >&2
+    exit 1
+  fi
+fi
 build="$1" work="$2" seq="$3" flags="${4:-}" python_preload="${5:-}"
 rm -rf "$work"
 mkdir -p "$work"
@@ -45,8 +56,16 @@ if ((deb)); then
   else
     step "no apt-get on this machine: the package's installation is not simulated"
   fi
-  dpkg-deb -x "$package" "$work/root"
-  prefix="$work/root/usr"
+  if ((system)); then
+    step "apt-get install $(basename "$package") (purged again at the end)"
+    trap 'DEBIAN_FRONTEND=noninteractive apt-get purge -y -q epichead > "$work/apt-purge.log" 2>&1 || cat "$work/apt-purge.log" >&2' EXIT
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -q "$package" > "$work/apt-install.log" 2>&1 ||
+      { cat "$work/apt-install.log" >&2; echo "install_test: apt-get could not install $package" >&2; exit 1; }
+    prefix=/usr
+  else
+    dpkg-deb -x "$package" "$work/root"
+    prefix="$work/root/usr"
+  fi
 else
   step "cmake --install $build --prefix $prefix"
   cmake --install "$build" --prefix "$prefix" > "$work/install.log"
@@ -54,8 +73,13 @@ fi
 for f in bin/epichead include/epichead/vision/model_tracker.h share/doc/epichead/LICENSE; do
   [[ -e "$prefix/$f" ]] || { echo "install_test: $prefix/$f was not installed" >&2; exit 1; }
 done
-config=$(find "$prefix" -name epicheadConfig.cmake | head -1)
-pc=$(find "$prefix" -name epichead.pc | head -1)
+if ((system)); then
+  config=$(dpkg -L epichead | grep '/epicheadConfig.cmake$' | head -1 || true)
+  pc=$(dpkg -L epichead | grep '/epichead.pc$' | head -1 || true)
+else
+  config=$(find "$prefix" -name epicheadConfig.cmake | head -1)
+  pc=$(find "$prefix" -name epichead.pc | head -1)
+fi
 [[ -n "$config" && -n "$pc" ]] || { echo "install_test: no epicheadConfig.cmake or epichead.pc under $prefix" >&2; exit 1; }
 
 step "a CMake project: find_package(epichead)"
@@ -65,7 +89,7 @@ cmake --build "$work/cmake-consumer" > "$work/consumer-build.log" 2>&1 || { cat 
 "$work/cmake-consumer/consumer" "$seq" 5
 
 step "a plain compile: pkg-config --cflags --libs epichead"
-if ((deb)); then
+if ((deb && !system)); then
   # The package's pkg-config file names /usr as its prefix: a copy names the unpacked root's.
   mkdir -p "$work/pkgconfig"
   sed "s|^prefix=.*|prefix=$prefix|" "$pc" > "$work/pkgconfig/epichead.pc"
