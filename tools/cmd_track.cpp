@@ -17,6 +17,7 @@
 #include <vector>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -392,6 +393,8 @@ int run_track(const TrackArgs& args) {
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
     // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
     // (a printed band, clutter), however well the image supports it: lost, so that detection runs.
+    const std::optional<double> tilt_error_rad =
+        report.status != TrackStatus::Lost ? (*predictor)->tilt_error_rad(entry.t_s, report.cam_T_obj) : std::nullopt;
     if (report.status != TrackStatus::Lost && (*predictor)->against_gravity(entry.t_s, report.cam_T_obj)) {
       report.status = TrackStatus::Lost;
       report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
@@ -438,6 +441,7 @@ int run_track(const TrackArgs& args) {
     if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));
     if (use_image_motion) per_frame.back()["image_motion"] = image_motion.frame_json();
+    if (tilt_error_rad) per_frame.back()["tilt_error_deg"] = *tilt_error_rad * 180 / std::numbers::pi;
 
     write_selected_lines(lines_csv, tracker, report, entry.frame, selected);
 

@@ -223,6 +223,10 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     return predictor_.check_tilt(t_s, cam_T_obj);
   }
+  std::optional<double> tilt_error_rad(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+    feed_until(t_s);
+    return predictor_.tilt_error_rad(t_s, cam_T_obj);
+  }
   std::optional<Upright> upright(double t_s) const override {
     const auto down_cam = predictor_.measured_down_cam(t_s);
     const auto down_obj = predictor_.learnt_down_obj();

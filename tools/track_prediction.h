@@ -51,6 +51,13 @@ class TrackPredictor {
     (void)cam_T_obj;
     return false;
   }
+  // With the IMU and the object's down learnt: how far that pose tilts the object from the down
+  // the accelerometer measures (rad), for report.json; nothing otherwise.
+  virtual std::optional<double> tilt_error_rad(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+    (void)t_s;
+    (void)cam_T_obj;
+    return std::nullopt;
+  }
   // With the IMU and the object's down learnt: which way is up at t_s, for detection.
   virtual std::optional<Upright> upright(double t_s) const {
     (void)t_s;

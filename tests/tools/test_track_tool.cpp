@@ -3,6 +3,7 @@
 // meets first.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -118,6 +119,17 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   CHECK(fused["success_rate"].get<double>() == 1.0);
   CHECK(fused["success_rate"].get<double>() >= vision["success_rate"].get<double>());
   CHECK(fused["rotation_deg"]["p95"].get<double>() < 0.75 * vision["rotation_deg"]["p95"].get<double>());
+  // Once the object's down is learnt (30 applied poses in a row), each tracked frame says how far
+  // its pose tilts the object from the accelerometer's down: a fraction of a degree when right.
+  std::vector<double> tilts;
+  for (const auto& f : report["per_frame"])
+    if (f.contains("tilt_error_deg")) {
+      CHECK(f["frame"].get<int>() >= 30);
+      tilts.push_back(f["tilt_error_deg"].get<double>());
+    }
+  REQUIRE(tilts.size() >= 20);
+  std::nth_element(tilts.begin(), tilts.begin() + tilts.size() / 2, tilts.end());
+  CHECK(tilts[tilts.size() / 2] < 1.0);
 }
 
 TEST_CASE("track without the IMU follows a hand-held burst by the frame's own motion, which constant velocity misses") {
