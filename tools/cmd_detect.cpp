@@ -30,7 +30,7 @@ using namespace epichead::vision;
 namespace fs = std::filesystem;
 
 struct DetectArgs {
-  std::string seq, out = "detect_out", imu = "off", model;
+  std::string seq, out = "detect_out", imu = "off", model, near;
   int frame = 0;
   bool every_hypothesis = false;
   DetectionArgs detection;
@@ -70,6 +70,14 @@ int run_detect(const DetectArgs& a) {
     prior.up_cam = up_from_imu(seq->imu(), entry.t_s);
     if (!prior.up_cam) std::fprintf(stderr, "epichead detect: note: no IMU sample near frame %d; searching every view\n", entry.frame);
   }
+  if (!a.near.empty()) {
+    // Re-acquisition's prior: the last pose before the frame that the tracker did not lose.
+    auto poses = read_pose_csv(a.near);
+    if (!poses) return fail(cmd, poses.error());
+    for (const auto& p : *poses)
+      if (p.frame < entry.frame && p.status != "lost") prior.near_cam_T_obj = p.cam_T_obj;
+    if (!prior.near_cam_T_obj) return fail(cmd, a.near + ": no pose before frame " + std::to_string(entry.frame) + " that is not lost");
+  }
   auto image = seq->read_frame(static_cast<std::size_t>(a.frame));
   if (!image) return fail(cmd, image.error());
   std::error_code ec;
@@ -108,6 +116,7 @@ int run_detect(const DetectArgs& a) {
   j["matches"] = result->matches;
   j["match_ms"] = result->match_ms;
   j["refine_ms"] = result->refine_ms;
+  j["near_used"] = prior.near_cam_T_obj.has_value();
   j["gravity_used"] = prior.up_cam.has_value() && prior.up_obj.has_value();
   nlohmann::json hyps = nlohmann::json::array();
   for (const auto& h : result->hypotheses) {
@@ -196,6 +205,10 @@ const CommandRegistration registration{
       app.add_option("--model", a->model,
                      "Search for this .cao model instead of the sequence's model.cao (e.g. to check that an object "
                      "not in view is reported not found)");
+      app.add_option("--near", a->near,
+                     "A pose CSV (init.csv's columns, e.g. track's poses.csv): its last pose before the frame that is "
+                     "not lost is refined and verified first, as re-acquisition after a loss does; the global search "
+                     "runs only when that pose is not verified");
       app.add_flag("--every-hypothesis", a->every_hypothesis,
                    "Also write hypothesis_NN.png: each refined hypothesis (colour) over its template's pose (grey)");
       add_detection_options(app, a->detection);

@@ -59,6 +59,33 @@ TEST_CASE("detect finds the real tea box in the first frame from the model alone
 
 }
 
+TEST_CASE("detect --near refines the last pose before the frame and skips the global search when it is verified") {
+  TempDir tmp("epichead_test_detect_near");
+  const std::string out = tmp / "det";
+  // The tea box has moved about a centimetre by frame 10 (ViSP's reference): the first frame's
+  // pose is refined onto it.
+  const auto run = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 10 --out " + q(out) + " --near " + q(kTeabox + "/init.csv") + kCache);
+  INFO(run.out << run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto j = nlohmann::json::parse(slurp(out + "/detection.json"));
+  CHECK(j["found"] == true);
+  CHECK(j["near_used"] == true);
+  CHECK(j["matches"] == 0);  // the templates were never matched
+  CHECK(j["hypotheses"].size() == 1);
+  const auto score = run_epichead(tmp, "score " + q(kTeabox) + " " + q(out + "/pose.csv") + " --reference " +
+                                           q(kTeabox + "/reference_visp.csv") + " --symmetric --json");
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["succeeded"] == 1);
+  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
+  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+
+  // A pose file with nothing before the frame is an error that names it.
+  const auto none = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(out) + " --near " + q(kTeabox + "/init.csv") + kCache);
+  CHECK(none.exit_code == 1);
+  CHECK(none.err.find("init.csv: no pose before frame 0") != std::string::npos);
+}
+
 TEST_CASE("detect builds its templates once into the cache, reads them after, and rebuilds a garbled cache with a warning") {
   // The coarsest view sphere (12 views) in a cache of its own: this test builds twice. It is
   // about the cache: 12 views are too few to find the box (exit 1, "not found"), and
