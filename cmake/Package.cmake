@@ -17,6 +17,16 @@ install(CODE "
   string(REPLACE \"%PREFIX%\" \"\${CMAKE_INSTALL_PREFIX}\" pc \"\${pc}\")
   file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/pkgconfig/epichead.pc\" \"\${pc}\")")
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# Debian's machine-readable copyright file (DEP-5), where Debian tools and users look for the
+# licence: the header, then LICENSE's own text.
+file(READ ${PROJECT_SOURCE_DIR}/LICENSE license_text)
+string(REGEX REPLACE "\n\n" "\n.\n" license_text "${license_text}")
+string(REGEX REPLACE "\n([^\n])" "\n \\1" license_text "${license_text}")
+file(WRITE ${PROJECT_BINARY_DIR}/copyright
+     "Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/\n"
+     "Upstream-Name: epichead\n\n"
+     "Files: *\nCopyright: 2026 the epichead authors\nLicense: BSD-3-Clause\n ${license_text}\n")
+install(FILES ${PROJECT_BINARY_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
 # The Debian package. Its dependencies: the "libraries" section of deps/debian-packages.txt
 # (what the installed headers and static libraries need to build against) and, found by
@@ -31,6 +41,13 @@ foreach(line IN LISTS dep_lines)
     list(APPEND package_depends "${line}")
   endif()
 endforeach()
+# The Python module is built for one Python (its file is named cpython-3XY): the package works
+# with that minor version only, as Debian's own extension modules say.
+if(EPICHEAD_PYTHON AND Python_VERSION_MINOR)
+  math(EXPR python_next_minor "${Python_VERSION_MINOR} + 1")
+  list(APPEND package_depends "python3 (>= ${Python_VERSION_MAJOR}.${Python_VERSION_MINOR}~)"
+       "python3 (<< ${Python_VERSION_MAJOR}.${python_next_minor})")
+endif()
 list(JOIN package_depends ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME epichead)
@@ -38,6 +55,10 @@ set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_VENDOR "the epichead authors")
 set(CPACK_PACKAGE_CONTACT "the epichead authors <epichead@users.noreply.github.com>")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Model-based tracking, IMU fusion and pan/tilt head control for a camera head")
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "Model-based tracking, IMU fusion and pan/tilt head control for a camera head
+ The onboard program of a camera head on a walking robot, its C++ libraries, CMake and
+ pkg-config files, and the Python module. Licence: BSD-3-Clause
+ (/usr/share/doc/epichead/copyright).")
 set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)

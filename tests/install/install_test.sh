@@ -46,6 +46,11 @@ if ((deb)); then
   for p in $(awk '/^# == /{section=$3} section=="libraries" && !/^#/ && NF {print $1}' "$here/../../deps/debian-packages.txt"); do
     grep -qE "(^|, )$p( |,|\$)" <<< "$depends" || { echo "install_test: $package does not depend on $p (Depends: $depends)" >&2; exit 1; }
   done
+  # The Python module is built for one Python: the package says which.
+  if grep -q '^EPICHEAD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then
+    grep -qE "(^|, )python3 \(>= 3\.[0-9]+~\), python3 \(<< 3\.[0-9]+\)" <<< "$depends" ||
+      { echo "install_test: $package does not pin the python3 its module is built for (Depends: $depends)" >&2; exit 1; }
+  fi
   if command -v apt-get > /dev/null; then
     step "apt-get install --simulate $(basename "$package")"
     # Unmet or misspelt dependencies make apt refuse (exit 100) and name them.
@@ -70,9 +75,12 @@ else
   step "cmake --install $build --prefix $prefix"
   cmake --install "$build" --prefix "$prefix" > "$work/install.log"
 fi
-for f in bin/epichead include/epichead/vision/model_tracker.h share/doc/epichead/LICENSE; do
+for f in bin/epichead include/epichead/vision/model_tracker.h share/doc/epichead/LICENSE share/doc/epichead/copyright; do
   [[ -e "$prefix/$f" ]] || { echo "install_test: $prefix/$f was not installed" >&2; exit 1; }
 done
+# Debian's copyright file (DEP-5) names the licence.
+grep -q '^License: BSD-3-Clause$' "$prefix/share/doc/epichead/copyright" ||
+  { echo "install_test: $prefix/share/doc/epichead/copyright does not name BSD-3-Clause" >&2; exit 1; }
 if ((system)); then
   config=$(dpkg -L epichead | grep '/epicheadConfig.cmake$' | head -1 || true)
   pc=$(dpkg -L epichead | grep '/epichead.pc$' | head -1 || true)
