@@ -324,6 +324,34 @@ TEST_CASE("the fisheye model projects as cv::fisheye::projectPoints, out to rays
   CHECK(inverse < 1e-9);
 }
 
+TEST_CASE("the fisheye model unprojects as cv::fisheye::undistortPoints, out to rays 80 deg off the axis") {
+  const Camera cam = fisheye_camera();
+  const auto& k = cam.intrinsics();
+  const cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
+  const auto& d = cam.distortion();
+  const cv::Vec4d D(d[0], d[1], d[2], d[3]);
+  // Pixels where the lens images rays up to 80 deg off its axis. Beyond the angle where the
+  // distortion polynomial turns back there is no inverse, and both disagree with any truth.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> off_axis(0.0, 80.0 * M_PI / 180.0), around(-M_PI, M_PI);
+  std::vector<cv::Point2d> pixels;
+  for (int i = 0; i < 500; ++i) {
+    const double a = off_axis(rng), b = around(rng);
+    const Eigen::Vector2d px = cam.project(Eigen::Vector3d(std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)));
+    pixels.emplace_back(px.x(), px.y());
+  }
+  std::vector<cv::Point2d> expected;
+  cv::fisheye::undistortPoints(pixels, expected, K, D, cv::noArray(), cv::noArray(),
+                               cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-14));
+  double worst = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const Eigen::Vector3d ray = cam.unproject(Eigen::Vector2d(pixels[i].x, pixels[i].y));
+    const Eigen::Vector2d xn = ray.head<2>() / ray.z();
+    worst = std::max(worst, (xn - Eigen::Vector2d(expected[i].x, expected[i].y)).norm() / std::max(1.0, xn.norm()));
+  }
+  CHECK(worst < 1e-6);
+}
+
 TEST_CASE("the fisheye model's Jacobian matches finite differences, on the axis too") {
   const Camera cam = fisheye_camera();
   for (const Eigen::Vector2d xn : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1e-9, -2e-9), Eigen::Vector2d(0.3, -0.2),
