@@ -61,6 +61,9 @@ TEST_CASE("Replay --dbc decodes the 8 ids of the real log that the anzen DBC des
   CHECK(temp["max_period_ms"].get<double>() == Approx(1141.928));  // the id's largest gap (test_replay_tool)
   CHECK(temp["signals"]["voltage_max_mono"]["count"] == 9);
   CHECK(temp["signals"]["voltage_max_mono"]["unit"] == "Volts");
+  // Its rate: 8 gaps over the span of its stamps (grep 183ECCE8: the first at 1605726422.019523,
+  // the last at 1605726431.006930).
+  CHECK(temp["signals"]["voltage_max_mono"]["rate_hz"].get<double>() == Approx(8.0 / (1605726431.006930 - 1605726422.019523)).epsilon(1e-6));
 
   // The multiplexor of MONOBLOCK_VOLTAGE_FRAMES reads 13 in 8 frames (grep -c '1830CCE8#0D'),
   // outside its [0|12]; the first at 1605726422.555484.
