@@ -215,6 +215,25 @@ TEST_CASE("sim and track show their progress on a terminal and end it with a new
   CHECK(track.terminal.back() == '\n');
 }
 
+TEST_CASE("sim-run and detection's template building show their progress on a terminal") {
+  TempDir tmp("epichead_test_progress_tty_run");
+  const auto sim_run = run_with_stderr_on_pty(tmp, {"sim-run", "mockup_walk", "--out", tmp / "run", "--seconds", "0.5", "--mode",
+                                                    "stabilise", "--downscale", "8", "--every", "0", "--settle-s", "0"});
+  INFO(sim_run.terminal);
+  REQUIRE(sim_run.exit_code == 0);
+  CHECK(sim_run.terminal.find("\rsim-run: ") != std::string::npos);
+  CHECK(sim_run.terminal.find(" frames") != std::string::npos);
+  CHECK(sim_run.terminal.find("taken") != std::string::npos);
+
+  // Templates built afresh (no cache), on the coarsest view sphere to keep it short.
+  const std::string seq = tmp / "mockup_walk";
+  REQUIRE(run_epichead(tmp, "sim mockup_walk --out " + q(seq) + " --frames 1").exit_code == 0);
+  const auto detect = run_with_stderr_on_pty(tmp, {"detect", seq, "--out", tmp / "det", "--views", "0", "--no-cache"});
+  INFO(detect.terminal);
+  CHECK(detect.terminal.find("epichead detect: building detection templates: ") != std::string::npos);
+  CHECK(detect.terminal.find(" templates") != std::string::npos);
+}
+
 TEST_CASE("sim, track and sim-run write nothing on stderr when it is not a terminal") {
   TempDir tmp("epichead_test_progress_quiet");
   const std::string seq = tmp / "mockup_walk";
