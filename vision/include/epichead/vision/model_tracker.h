@@ -71,8 +71,7 @@ struct ModelTrackerOptions {
   PoseOptions pose;
   VisibilityOptions visibility;
   int min_features = 4;            // lines needed for a pose (three fix it; one spare against a bad one);
-                                   // a found ellipse counts as two lines; one fewer for a body of
-                                   // revolution whose turn is left free (five degrees to fix)
+                                   // a found ellipse counts as two lines
   double min_inlier_ratio = 0.5;   // below this share of found lines explained: degraded
   double max_scale_px = 2.5;       // robust residual scale above this: degraded (blur, partial fits);
                                    // above twice this the pose explains nothing: lost
