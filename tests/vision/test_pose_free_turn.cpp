@@ -227,27 +227,3 @@ TEST_CASE("without a free turn the facet edges pin the turn and the same problem
   const Eigen::Vector3d d = result.cam_T_obj.linear() * s.axis.direction_obj;
   CHECK(d.dot(result.covariance.bottomRightCorner<3, 3>() * d) < 0.3);
 }
-
-TEST_CASE("with a free turn one rim and one silhouette line fix the pose; without it they are too few", "[pose][free_turn]") {
-  // A lamp shade whose other side a pole hides: the top rim and one limb edge are what is left.
-  Scene s = make_scene(kSpinRad);
-  s.problem.ellipses.pop_back();
-  s.problem.lines.pop_back();
-  REQUIRE(s.problem.ellipses.size() == 1);
-  REQUIRE(s.problem.lines.size() == 1);
-  const Eigen::Isometry3d prior = turned_prior(s, 3 * kDeg);
-  PoseEstimator estimator(kCamera);
-  PoseResult result;
-  s.problem.free_turn = s.axis;
-  estimator.estimate(s.problem, prior, result);
-  INFO(result.reason);
-  REQUIRE(result.status == PoseStatus::Ok);
-  CHECK(rotation_error_without_turn_rad(s.truth, result.cam_T_obj, s.axis) < 0.05 * kDeg);
-  CHECK((result.cam_T_obj.translation() - s.truth.translation()).norm() < 0.0005);
-
-  s.problem.free_turn.reset();
-  PoseResult six;
-  estimator.estimate(s.problem, prior, six);
-  CHECK(six.status == PoseStatus::TooFewFeatures);
-  CHECK(six.reason == "2 usable features (need 3 or more)");
-}

@@ -235,11 +235,7 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
 
   TrackReason reasons = TrackReason::None;
   if (out.visible + out.ellipses_visible < 2) reasons = reasons | TrackReason::NotVisible;
-  // A body of revolution whose turn about its axis is left free has five degrees to fix, not
-  // six: one feature fewer does, so a rim and one silhouette (a lamp shade whose other side a
-  // pole hides) still give a pose with one constraint to spare.
-  const int min_features = options_.min_features - (problem_.free_turn ? 1 : 0);
-  if (out.found + 2 * out.ellipses_found < min_features) reasons = reasons | TrackReason::FewFeatures;
+  if (out.found + 2 * out.ellipses_found < options_.min_features) reasons = reasons | TrackReason::FewFeatures;
   bool pose_ok = reasons == TrackReason::None;
   out.inliers = out.rejected = 0;
   if (pose_ok) {

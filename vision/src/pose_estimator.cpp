@@ -79,12 +79,9 @@ bool enough_features(const PoseProblem& problem, PoseResult& out) {
   for (const auto& e : problem.ellipses) if (e.points_px.size() >= 5) { ++features; dims += 5; }
   features += static_cast<int>(problem.points_3d.size());
   dims += 3 * static_cast<int>(problem.points_3d.size());
-  // A body of revolution with its turn left free has five degrees to fix: a rim (five
-  // residual dimensions) and one silhouette line fix them with one to spare.
-  const int need = problem.free_turn ? 2 : 3;
-  if (features >= need && dims >= 6) return true;
+  if (features >= 3 && dims >= 6) return true;
   out.status = PoseStatus::TooFewFeatures;
-  out.reason = std::to_string(features) + " usable features (need " + std::to_string(need) + " or more)";
+  out.reason = std::to_string(features) + " usable features (need 3 or more)";
   return false;
 }
 
