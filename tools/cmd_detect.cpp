@@ -1,4 +1,4 @@
-// `epichead detect SEQ --frame N [--imu on] [--out DIR]`: finds the model's pose in one frame
+// `epichead detect SEQ --frame N [--imu on] [--near POSES.csv] [--out DIR]`: finds the model's pose in one frame
 // from the CAD model and the camera alone (vision/detector.h). Writes DIR/pose.csv (init.csv's
 // format: copy it in as the sequence's init.csv), DIR/detection.json (every hypothesis, the
 // timings, the template cache) and DIR/detection.png (the found pose drawn over the frame).
@@ -74,8 +74,12 @@ int run_detect(const DetectArgs& a) {
     // Re-acquisition's prior: the last pose before the frame that the tracker did not lose.
     auto poses = read_pose_csv(a.near);
     if (!poses) return fail(cmd, poses.error());
+    int latest = -1;
     for (const auto& p : *poses)
-      if (p.frame < entry.frame && p.status != "lost") prior.near_cam_T_obj = p.cam_T_obj;
+      if (p.frame < entry.frame && p.frame > latest && p.status != "lost") {
+        latest = p.frame;
+        prior.near_cam_T_obj = p.cam_T_obj;
+      }
     if (!prior.near_cam_T_obj) return fail(cmd, a.near + ": no pose before frame " + std::to_string(entry.frame) + " that is not lost");
   }
   auto image = seq->read_frame(static_cast<std::size_t>(a.frame));

@@ -34,6 +34,18 @@ std::string without_init(const TempDir& tmp, const std::string& name) {
   return dir;
 }
 
+// A detected tea box pose against ViSP's on its frame, up to the box's half turns (a plain
+// box's wire-frame cannot tell them apart).
+void check_against_visp(const TempDir& tmp, const std::string& pose_csv) {
+  const auto score = run_epichead(tmp, "score " + q(kTeabox) + " " + q(pose_csv) + " --reference " +
+                                           q(kTeabox + "/reference_visp.csv") + " --symmetric --json");
+  REQUIRE(score.exit_code == 0);
+  const auto s = nlohmann::json::parse(score.out);
+  CHECK(s["succeeded"] == 1);
+  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
+  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+}
+
 }  // namespace
 
 TEST_CASE("detect finds the real tea box in the first frame from the model alone") {
@@ -47,22 +59,13 @@ TEST_CASE("detect finds the real tea box in the first frame from the model alone
   CHECK(j["best"]["support"].get<double>() > 0.7);
   CHECK(fs::exists(j["template_cache"].get<std::string>()));
   CHECK(fs::exists(out + "/detection.png"));
-  // The pose against ViSP's on this frame, up to the box's half turns (a plain box's wire-frame
-  // cannot tell them apart).
-  const auto score = run_epichead(tmp, "score " + q(kTeabox) + " " + q(out + "/pose.csv") + " --reference " +
-                                           q(kTeabox + "/reference_visp.csv") + " --symmetric --json");
-  REQUIRE(score.exit_code == 0);
-  const auto s = nlohmann::json::parse(score.out);
-  CHECK(s["succeeded"] == 1);
-  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
-  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
-
+  check_against_visp(tmp, out + "/pose.csv");
 }
 
 TEST_CASE("detect --near refines the last pose before the frame and skips the global search when it is verified") {
   TempDir tmp("epichead_test_detect_near");
   const std::string out = tmp / "det";
-  // The tea box has moved about a centimetre by frame 10 (ViSP's reference): the first frame's
+  // By frame 10 the tea box has moved 2 mm in ViSP's reference: the first frame's
   // pose is refined onto it.
   const auto run = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 10 --out " + q(out) + " --near " + q(kTeabox + "/init.csv") + kCache);
   INFO(run.out << run.err);
@@ -72,13 +75,7 @@ TEST_CASE("detect --near refines the last pose before the frame and skips the gl
   CHECK(j["near_used"] == true);
   CHECK(j["matches"] == 0);  // the templates were never matched
   CHECK(j["hypotheses"].size() == 1);
-  const auto score = run_epichead(tmp, "score " + q(kTeabox) + " " + q(out + "/pose.csv") + " --reference " +
-                                           q(kTeabox + "/reference_visp.csv") + " --symmetric --json");
-  REQUIRE(score.exit_code == 0);
-  const auto s = nlohmann::json::parse(score.out);
-  CHECK(s["succeeded"] == 1);
-  CHECK(s["rotation_deg"]["median"].get<double>() < 3.0);
-  CHECK(s["translation_mm"]["median"].get<double>() < 10.0);
+  check_against_visp(tmp, out + "/pose.csv");
 
   // A pose file with nothing before the frame is an error that names it.
   const auto none = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(out) + " --near " + q(kTeabox + "/init.csv") + kCache);
