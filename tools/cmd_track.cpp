@@ -391,13 +391,13 @@ int run_track(const TrackArgs& args) {
       }
     }
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
-    // The tracked pose's tilt against the accelerometer's down, for report.json (before the
-    // check below may mark the frame lost).
+    // The tracked pose's tilt against the accelerometer's down, for report.json and the check
+    // below (measured before the check may mark the frame lost).
     const std::optional<double> tilt_error_rad =
         report.status != TrackStatus::Lost ? (*predictor)->tilt_error_rad(entry.t_s, report.cam_T_obj) : std::nullopt;
     // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
     // (a printed band, clutter), however well the image supports it: lost, so that detection runs.
-    if (report.status != TrackStatus::Lost && (*predictor)->against_gravity(entry.t_s, report.cam_T_obj)) {
+    if (report.status != TrackStatus::Lost && (*predictor)->against_gravity(entry.t_s, tilt_error_rad)) {
       report.status = TrackStatus::Lost;
       report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
       ++counts.against_gravity;

@@ -219,9 +219,9 @@ class ImuPredictor final : public TrackPredictor {
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;  // nothing before the filter starts
     return std::nullopt;
   }
-  bool against_gravity(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+  bool against_gravity(double t_s, std::optional<double> error_rad) override {
     feed_until(t_s);
-    return predictor_.check_tilt(t_s, cam_T_obj);
+    return predictor_.check_tilt(t_s, error_rad);
   }
   std::optional<double> tilt_error_rad(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
     feed_until(t_s);

@@ -46,9 +46,10 @@ class TrackPredictor {
   virtual std::optional<Eigen::Isometry3d> fallback(double t_s) { (void)t_s; return std::nullopt; }
   // With the IMU: true when a tracked pose exposed at t_s tilts the object away from the down the
   // accelerometer measures (fusion::Predictor::check_tilt): a wrong lock, to be taken as lost.
-  virtual bool against_gravity(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+  // `error_rad` is tilt_error_rad(t_s, the pose), measured once by the caller.
+  virtual bool against_gravity(double t_s, std::optional<double> error_rad) {
     (void)t_s;
-    (void)cam_T_obj;
+    (void)error_rad;
     return false;
   }
   // With the IMU and the object's down learnt: how far that pose tilts the object from the down

@@ -381,8 +381,9 @@ std::optional<double> Predictor::tilt_error_rad(double t_s, const Eigen::Isometr
   return gravity_.tilt_error_rad(cam_T_obj.linear(), measured_down_cam(t_s));
 }
 
-bool Predictor::check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj) {
-  const std::optional<double> e = tilt_error_rad(t_s, cam_T_obj);
+bool Predictor::check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj) { return check_tilt(t_s, tilt_error_rad(t_s, cam_T_obj)); }
+
+bool Predictor::check_tilt(double t_s, std::optional<double> e) {
   if (!e) return false;
   const bool against = *e > options_.gravity_check.max_tilt_error_rad;
   const int forgotten = gravity_.forgotten();

@@ -117,6 +117,9 @@ class Predictor {
   // a wrong lock whatever its support; the caller takes the frame as lost (and detects again).
   // Counted, and a long run of them forgets the learnt down (the object was moved).
   bool check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj);
+  // The same verdict on an error already measured by tilt_error_rad(t_s, ...) (a caller that
+  // reports the error too need not measure it twice); an empty error is no verdict (false).
+  bool check_tilt(double t_s, std::optional<double> error_rad);
   PredictorStatus status(double now_t_s) const;
   // Forgets the state (not the buffered samples): the next pose initialises again.
   void reset();
