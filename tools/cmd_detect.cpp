@@ -128,6 +128,7 @@ int run_detect(const DetectArgs& a) {
     e["support"] = h.support;
     e["score"] = h.score;
     e["supported_px"] = h.supported_px;
+    e["colour_continuation"] = h.colour_continuation;
     e["similarity"] = h.similarity;
     e["status"] = to_string(h.status);
     e["start"] = pose_json(h.start_cam_T_obj);

@@ -7,10 +7,12 @@
 # turn about their axis. Writes DIR/rows.tsv and DIR/section.md (the table in docs/detection.md).
 # Runs already in DIR/rows are kept, so an interrupted evaluation resumes where it stopped.
 # Usage: tools/detection_eval.sh [--dev "1 2 3"] [--held "101 ... 112"] [--scenarios "a b"]
-#                                [--frames N] [--jobs J] [--out DIR] [--bin PATH]
+#                                [--frames N] [--jobs J] [--out DIR] [--bin PATH] [--detect-only]
 #   --scenarios   default: mockup_walk box_clutter lampshade can bowl (office_pan's model is the
 #                 room around the camera: it is never wholly in view, which detection needs)
 #   --frames N    frames per sequence (default 90)
+#   --detect-only detection in the first and middle frames alone, no tracking (the tracking
+#                 columns then show "-")
 #   --table-only  only make the table from the rows in DIR (of a run still going, or stopped)
 # Needs jq.
 set -euo pipefail
@@ -23,6 +25,7 @@ frames=90
 jobs=$(nproc)
 out="$here/out/detection_eval"
 table_only=0
+detect_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --dev) dev="$2"; shift 2 ;;
@@ -33,7 +36,8 @@ while [[ $# -gt 0 ]]; do
     --out) out="$2"; shift 2 ;;
     --bin) bin="$2"; shift 2 ;;
     --table-only) table_only=1; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    --detect-only) detect_only=1; shift ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "detection_eval: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -71,6 +75,11 @@ one() {
     cols+=("$found" "$right")
     [[ $f == 0 ]] && local ms0="$ms"
   done
+  if ((detect_only)); then
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t-\t-\t-\t-\t-\n' "$scenario" "$seed" "$set" "${cols[@]}" "$ms0" > "$out/rows/$scenario-$seed.tsv"
+    rm -rf "$seq"
+    return 0
+  fi
   "$bin" track "$seq" --out "$work/init" --every 0 --no-video > "$work/init.log" 2>&1
   local no_init="$out/seq/$scenario-$seed-noinit"
   rm -rf "$no_init"
@@ -86,7 +95,7 @@ one() {
     "$(jq -r '.acquisition.start.frame // "-"' "$work/noinit/report.json")" > "$out/rows/$scenario-$seed.tsv"
 }
 export -f one score_args
-export bin out frames
+export bin out frames detect_only
 
 runs() {  # scenario seed set, one per line
   for s in $dev; do echo "$1 $s dev"; done
@@ -108,15 +117,20 @@ awk -F'\t' '
                                   return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
   NF < 13 || $9 == "" || $10 == "" { next }  # a run cut short (its row is incomplete)
   { k = $1 " " $3; n[k]++; right[k] += $5 + $7; found_wrong[k] += ($4 && !$5) + ($6 && !$7)
-    no[k, n[k]] = $9; if (!(k in mn) || $9 < mn[k]) mn[k] = $9; ok[k] += ($9 >= $10 - 1)
-    ms[k, n[k]] = $8; re[k] += $11 }
+    ms[k, n[k]] = $8
+    if ($9 == "-") next  # detection only
+    t[k]++; no[k, t[k]] = $9; if (!(k in mn) || $9 < mn[k]) mn[k] = $9; ok[k] += ($9 >= $10 - 1)
+    re[k] += $11 }
   END {
     print "| scenario | seeds | detected right (frames 0 and middle) | found but wrong | detect ms median | no init.csv: median / min success % | runs >= init.csv run - 1 | re-acquisitions |"
     print "|---|---|---|---|---|---|---|---|"
     for (k in n) {
       split(k, p, " "); m = n[k]
-      for (i = 1; i <= m; i++) { a[i] = no[k, i]; b[i] = ms[k, i] }
-      printf "| %s | %s (%d) | %d / %d | %d | %.0f | %.1f / %.1f | %d / %d | %d |\n", p[1], p[2], m, right[k], 2 * m, found_wrong[k], med(b, m), med(a, m), mn[k], ok[k], m, re[k]
+      for (i = 1; i <= m; i++) b[i] = ms[k, i]
+      printf "| %s | %s (%d) | %d / %d | %d | %.0f | ", p[1], p[2], m, right[k], 2 * m, found_wrong[k], med(b, m)
+      if (!t[k]) { print "- | - | - |"; continue }
+      for (i = 1; i <= t[k]; i++) a[i] = no[k, i]
+      printf "%.1f / %.1f | %d / %d | %d |\n", med(a, t[k]), mn[k], ok[k], t[k], re[k]
     }
   }' "$out/rows.tsv" | { read -r h; read -r s; echo "$h"; echo "$s"; sort; } > "$out/section.md"
 cat "$out/section.md"

@@ -32,6 +32,11 @@ void add_detection_options(CLI::App& app, DetectionArgs& a) {
   app.add_option("--min-support", a.options.min_support,
                  "Detection: share of the model's outline an image edge must support for a pose to count as found")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--max-colour-continuation", a.options.max_colour_continuation,
+                 "Detection: how much the colours across the outline's lines may still differ past the object's "
+                 "corners, relative to along it, for a pose to count as found (a model laid on a facade's lines "
+                 "finds them running on; 2 turns the test off)")
+      ->check(CLI::Range(0.0, 2.0));
 }
 
 std::expected<std::unique_ptr<vision::Detector>, std::string> make_detector(const std::string& command,

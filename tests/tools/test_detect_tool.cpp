@@ -60,6 +60,23 @@ TEST_CASE("detect finds the real tea box in the first frame from the model alone
   CHECK(fs::exists(j["template_cache"].get<std::string>()));
   CHECK(fs::exists(out + "/detection.png"));
   check_against_visp(tmp, out + "/pose.csv");
+  // The box stands in front of its background: past its corners the colours across its
+  // outline's lines stop differing (0.18 measured here; a model laid on a facade, near 1).
+  CHECK(j["best"]["colour_continuation"].get<double>() < 0.35);
+  // Hypotheses whose outline runs on past the object rank after all the others.
+  bool runs_on_seen = false;
+  for (const auto& h : j["hypotheses"]) {
+    const bool runs_on = h["colour_continuation"].get<double>() > 0.6;
+    CHECK((runs_on || !runs_on_seen));
+    runs_on_seen = runs_on_seen || runs_on;
+  }
+
+  // A limit below what the box shows refuses it: the test decides what is found.
+  const auto strict = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(tmp / "strict") + kCache +
+                                            " --max-colour-continuation 0.05");
+  INFO(strict.out << strict.err);
+  CHECK(strict.exit_code != 0);
+  CHECK(nlohmann::json::parse(slurp(tmp / "strict/detection.json"))["found"] == false);
 }
 
 TEST_CASE("detect --near refines the last pose before the frame and skips the global search when it is verified") {

@@ -158,6 +158,54 @@ TEST_CASE("edge support: a drawn outline supports its own pose fully, a blank im
   CHECK(edge_support(blank, seen).share == 0.0);
 }
 
+TEST_CASE("colour continuation: across the outline's lines the colours differ along the object and stop differing past it") {
+  const CadModel model = box(0.165, 0.068, 0.08);
+  const Camera cam = camera();
+  Visibility visibility(model, cam);
+  VisibleModel seen;
+  visibility.compute(looking_at_box(0.5), seen);
+  REQUIRE(seen.edges.size() >= 6);
+  std::vector<cv::Point> corners, hull;
+  for (const auto& e : seen.edges) {
+    corners.emplace_back(static_cast<int>(std::lround(e.a_px.x())), static_cast<int>(std::lround(e.a_px.y())));
+    corners.emplace_back(static_cast<int>(std::lround(e.b_px.x())), static_cast<int>(std::lround(e.b_px.y())));
+  }
+  cv::convexHull(corners, hull);
+
+  // A pale object on a noisy green background (clutter whose edges are everywhere).
+  cv::RNG rng(7);
+  cv::Mat scene(cam.height_px(), cam.width_px(), CV_8UC3);
+  rng.fill(scene, cv::RNG::UNIFORM, cv::Scalar(20, 90, 20), cv::Scalar(90, 200, 90));
+  cv::Mat object(scene.size(), CV_8UC3);
+  rng.fill(object, cv::RNG::UNIFORM, cv::Scalar(200, 200, 200), cv::Scalar(250, 250, 250));
+  cv::Mat mask = cv::Mat::zeros(scene.size(), CV_8UC1);
+  cv::fillConvexPoly(mask, hull, cv::Scalar(255));
+  object.copyTo(scene, mask);
+  const ColourContinuation alone = colour_continuation(scene, seen);
+  CHECK(alone.ends >= 6);
+  CHECK(alone.ratio < 0.2);
+
+  // A facade the outline lies on: every edge's line is a colour boundary across the image.
+  cv::Mat facade(scene.size(), CV_8UC3);
+  for (int y = 0; y < facade.rows; ++y)
+    for (int x = 0; x < facade.cols; ++x) {
+      cv::Vec3i c(30, 30, 30);
+      for (std::size_t i = 0; i < seen.edges.size(); ++i) {
+        const auto& e = seen.edges[i];
+        const Eigen::Vector2d d = e.b_px - e.a_px, q = Eigen::Vector2d(x, y) - e.a_px;
+        if (d.x() * q.y() - d.y() * q.x() > 0) c[static_cast<int>(i % 3)] += 35;
+      }
+      facade.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(c[0]), cv::saturate_cast<uchar>(c[1]), cv::saturate_cast<uchar>(c[2]));
+    }
+  const ColourContinuation running_on = colour_continuation(facade, seen);
+  CHECK(running_on.ends == alone.ends);  // which ends count depends on the pose alone
+  CHECK(running_on.ratio > 0.8);
+
+  // Not a colour frame, or nothing drawn: no ratio, no ends.
+  CHECK(colour_continuation(cv::Mat(), seen).ends == 0);
+  CHECK(colour_continuation(scene, VisibleModel{}).ends == 0);
+}
+
 TEST_CASE("model symmetries: a box of three different sides has three half turns, a wedge none") {
   const auto turns = model_symmetries(box(0.165, 0.068, 0.08));
   REQUIRE(turns.size() == 3);

@@ -158,6 +158,7 @@ DetectionHypothesis Detector::Impl::measure(DetectionHypothesis h, bool whole_ob
     h.support = support.share;
     h.score = support.share * static_cast<double>(support.supported);
     h.supported_px = static_cast<double>(support.supported) * so.step_px;
+    h.colour_continuation = detail::colour_continuation(colour, visible).ratio;
   }
   return h;
 }
@@ -195,6 +196,7 @@ std::expected<cv::Mat, std::string> Detector::Impl::take_frame(const cv::Mat& fr
     cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
   }
   gradients.compute(grey);
+  bgr.copyTo(colour);
   const int pad_x = (kPadMultiple - bgr.cols % kPadMultiple) % kPadMultiple;
   const int pad_y = (kPadMultiple - bgr.rows % kPadMultiple) % kPadMultiple;
   if (pad_x || pad_y) cv::copyMakeBorder(bgr, bgr, 0, pad_y, 0, pad_x, cv::BORDER_REPLICATE);
@@ -240,8 +242,10 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
 
   const auto t1 = Clock::now();
   for (std::size_t i = 0; i < starts.size(); ++i) result.hypotheses.push_back(d.refine(starts[i], similarity[i]));
-  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(),
-                   [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
+  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(), [&d](const DetectionHypothesis& a, const DetectionHypothesis& b) {
+    if (d.runs_on(a) != d.runs_on(b)) return d.runs_on(b);
+    return a.score > b.score;
+  });
   result.refine_ms += ms_since(t1);
   for (DetectionHypothesis& h : result.hypotheses) d.choose_symmetric(h, prior);
   if (!result.hypotheses.empty()) {

@@ -72,6 +72,7 @@ struct Detector::Impl {
   VisibleModel visible;
   WindowImage window_image;
   detail::EdgeGradients gradients;
+  cv::Mat colour;  // the frame, BGR, unpadded (colour_continuation)
   cv::Ptr<cv::linemod::Detector> line2d;
   std::vector<Eigen::Vector3d> views;
   std::vector<double> rolls_rad;
@@ -124,8 +125,9 @@ struct Detector::Impl {
   // the world's.
   // A can found again after a cover is otherwise as likely upside down (issue 19).
   void choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const;
+  bool runs_on(const DetectionHypothesis& h) const { return h.colour_continuation > options.max_colour_continuation; }
   bool verified(const DetectionHypothesis& h) const {
-    return h.support >= options.min_support && h.supported_px >= options.min_supported_px;
+    return h.support >= options.min_support && h.supported_px >= options.min_supported_px && !runs_on(h);
   }
 };
 

@@ -1,6 +1,8 @@
 #include "edge_support.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -73,6 +75,88 @@ EdgeSupport edge_support(const EdgeGradients& gradients, const VisibleModel& vis
   }
   EdgeSupport out{c.samples, c.supported, 0.0};
   if (c.samples >= options.min_samples) out.share = static_cast<double>(c.supported) / static_cast<double>(c.samples);
+  return out;
+}
+
+namespace {
+
+// The convex hull of what is drawn: every visible edge's ends and points around every ellipse.
+void drawn_hull(const VisibleModel& visible, std::vector<cv::Point2f>& hull) {
+  std::vector<cv::Point2f> drawn;
+  for (const auto& e : visible.edges) {
+    drawn.emplace_back(static_cast<float>(e.a_px.x()), static_cast<float>(e.a_px.y()));
+    drawn.emplace_back(static_cast<float>(e.b_px.x()), static_cast<float>(e.b_px.y()));
+  }
+  for (const auto& el : visible.ellipses) {
+    const double ca = std::cos(el.angle_rad), sa = std::sin(el.angle_rad);
+    for (int i = 0; i < 32; ++i) {
+      const double t = 2 * M_PI * i / 32, ex = el.semi_major_px * std::cos(t), ey = el.semi_minor_px * std::sin(t);
+      drawn.emplace_back(static_cast<float>(el.centre_px.x() + ca * ex - sa * ey), static_cast<float>(el.centre_px.y() + sa * ex + ca * ey));
+    }
+  }
+  hull.clear();
+  if (drawn.size() >= 3) cv::convexHull(drawn, hull);
+}
+
+bool outside(const std::vector<cv::Point2f>& hull, const Eigen::Vector2d& p, double by_px) {
+  return cv::pointPolygonTest(hull, cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y())), true) < -by_px;
+}
+
+// Mean colours of the two strips beside a stretch of a line, 2-5 px off it.
+struct Sides {
+  cv::Vec3d left = 0, right = 0;
+  int n = 0;
+  double contrast() const { return n ? cv::norm((left - right) / n) : 0.0; }
+};
+
+}  // namespace
+
+ColourContinuation colour_continuation(const cv::Mat& bgr, const VisibleModel& visible, const ContinuationOptions& options) {
+  ColourContinuation out;
+  if (bgr.empty() || bgr.type() != CV_8UC3) return out;
+  std::vector<cv::Point2f> hull;
+  drawn_hull(visible, hull);
+  if (hull.size() < 3) return out;
+  constexpr double kStep = 2.0, kNearSide = 2.0, kFarSide = 5.0, kMinEdgeContrast = 10.0, kMaxRatio = 2.0;
+  constexpr int kMinPairs = 4;
+  // Adds the strips beside p (line normal n); outside_only: both sides must lie outside the hull.
+  const auto add = [&](Sides& sides, const Eigen::Vector2d& p, const Eigen::Vector2d& n, bool outside_only) {
+    cv::Vec3d l = 0, r = 0;
+    for (double k = kNearSide; k <= kFarSide; k += 1.0) {
+      const Eigen::Vector2d a = p + k * n, b = p - k * n;
+      const int ax = static_cast<int>(std::lround(a.x())), ay = static_cast<int>(std::lround(a.y()));
+      const int bx = static_cast<int>(std::lround(b.x())), by = static_cast<int>(std::lround(b.y()));
+      if (ax < 0 || ay < 0 || bx < 0 || by < 0 || ax >= bgr.cols || bx >= bgr.cols || ay >= bgr.rows || by >= bgr.rows) return;
+      if (outside_only && (!outside(hull, a, 1.0) || !outside(hull, b, 1.0))) return;
+      l += cv::Vec3d(bgr.at<cv::Vec3b>(ay, ax));
+      r += cv::Vec3d(bgr.at<cv::Vec3b>(by, bx));
+    }
+    sides.left += l;
+    sides.right += r;
+    ++sides.n;
+  };
+  double sum = 0;
+  for (const auto& e : visible.edges) {
+    // The silhouette alone: a crease has the object on both sides, its colours may not differ.
+    if (e.kind == EdgeKind::Crease || e.kind == EdgeKind::Wire) continue;
+    const Eigen::Vector2d d = e.b_px - e.a_px;
+    const double len = d.norm();
+    if (!(len > 2 * options.gap_px + 2 * kStep)) continue;
+    const Eigen::Vector2d u = d / len, n(-u.y(), u.x());
+    Sides along;
+    for (double s = options.gap_px; s <= len - options.gap_px; s += kStep) add(along, e.a_px + s * u, n, false);
+    if (along.n < kMinPairs) continue;
+    const double edge_contrast = std::max(kMinEdgeContrast, along.contrast());
+    const double reach = std::min(options.max_reach_px, options.reach_share * len);
+    for (const auto& [end, dir] : {std::pair{e.b_px, u}, std::pair{e.a_px, Eigen::Vector2d(-u)}}) {
+      Sides past;
+      for (double s = options.gap_px; s <= reach + 1e-9; s += kStep) add(past, end + s * dir, n, true);
+      if (past.n < kMinPairs) continue;
+      sum += std::min(kMaxRatio, past.contrast() / edge_contrast);
+      ++out.ends;
+    }
+  }
+  if (out.ends) out.ratio = sum / out.ends;
   return out;
 }
 

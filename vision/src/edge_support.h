@@ -31,4 +31,26 @@ struct EdgeSupport {
 // Samples every visible edge and ellipse.
 EdgeSupport edge_support(const EdgeGradients& gradients, const VisibleModel& visible, const EdgeSupportOptions& options = {});
 
+// Does the outline run on past the object? Across a silhouette edge the object meets its
+// background, and past its ends the background meets itself, so the colour difference across
+// the edge's line drops there; a wire-frame laid on a grid of lines (a building's facade and
+// windows, a tiled floor) finds it carrying on. Samples lie on the lines of the visible
+// silhouette edges beyond their ends, up to reach_share of the edge's length (at most
+// max_reach_px), outside the projected model's convex hull.
+struct ContinuationOptions {
+  double gap_px = 4.0;          // first sample this far past the end (corners mix two edges)
+  double reach_share = 0.5;     // of the edge's length
+  double max_reach_px = 40.0;
+};
+// Per end: the difference of mean colours on the two sides of the line past the end (strips
+// 2-5 px off the line, both outside the hull) over the same difference along the edge itself
+// (at least 10 levels). Returns the mean of these ratios (each capped at 2) and how many ends
+// gave one. Textured clutter, whose edges are everywhere, differs little from one side of a
+// line to the other over a strip, so the measure holds where edge counts do not.
+struct ColourContinuation {
+  double ratio = 0;
+  int ends = 0;
+};
+ColourContinuation colour_continuation(const cv::Mat& bgr, const VisibleModel& visible, const ContinuationOptions& options = {});
+
 }  // namespace epichead::vision::detail

@@ -60,6 +60,12 @@ struct DetectorOptions {
   // box seen face-on is a rectangle) is matched by printed rectangles in clutter as readily as
   // by the object (late_entry: 0.81 of a 300 px outline on a poster).
   double min_supported_px = 400.0;
+  // ... and the outline does not run on past the object: across the silhouette's lines past
+  // their ends the colours differ at most this much, relative to across the lines along the
+  // object (DetectionHypothesis::colour_continuation). A wire-frame laid on a building's facade
+  // or windows finds its lines running on; an object in front of its background does not.
+  // Hypotheses whose outline runs on rank after the others.
+  double max_colour_continuation = 0.6;
 };
 
 // A pose found in one frame.
@@ -73,6 +79,10 @@ struct DetectionHypothesis {
   // loses against the whole object.
   double score = 0;
   double supported_px = 0;  // length of the outline an image edge supports
+  // How much the colours across the silhouette's lines still differ past the object's corners,
+  // relative to along the object (edge_support.h, colour_continuation; about 0 for an object
+  // in front of its background, near 1 when the outline lies on lines that run on).
+  double colour_continuation = 0;
   TrackStatus status = TrackStatus::Lost;  // of the last refinement step
 };
 
@@ -81,7 +91,8 @@ struct DetectionResult {
   DetectionHypothesis best;
   int templates_matched = 0;   // templates the gravity filter left
   int matches = 0;             // LINE-2D matches above min_similarity
-  std::vector<DetectionHypothesis> hypotheses;  // every refined hypothesis, best score first
+  // Every refined hypothesis, best first: by score, those whose outline runs on last.
+  std::vector<DetectionHypothesis> hypotheses;
   double match_ms = 0, refine_ms = 0;
 };
 
