@@ -71,7 +71,7 @@ TEST_CASE("detect finds the real tea box in the first frame from the model alone
     runs_on_seen = runs_on_seen || runs_on;
   }
 
-  // A limit below what the box shows refuses it: the test decides what is found.
+  // A limit below what the box shows refuses it: the limit decides what is found.
   const auto strict = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(tmp / "strict") + kCache +
                                             " --max-colour-continuation 0.05");
   INFO(strict.out << strict.err);
