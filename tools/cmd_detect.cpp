@@ -169,17 +169,17 @@ int run_detect(const DetectArgs& a) {
       draw_visible_model(pic, compute_visibility(model, seq->camera(), h.start_cam_T_obj, tracking.visibility), start_style);
       draw_visible_model(pic, compute_visibility(model, seq->camera(), h.cam_T_obj, tracking.visibility));
       char text[128];
-      std::snprintf(text, sizeof text, "hypothesis %zu  support %.2f  score %.0f  similarity %.0f  %s", i, h.support, h.score,
-                    h.similarity, to_string(h.status));
+      std::snprintf(text, sizeof text, "hypothesis %zu  support %.2f  runs on %.2f  score %.0f  similarity %.0f  %s", i, h.support,
+                    h.colour_continuation, h.score, h.similarity, to_string(h.status));
       cv::putText(pic, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
       char name[64];
       std::snprintf(name, sizeof name, "hypothesis_%02zu.png", i);
       if (!cv::imwrite((fs::path(a.out) / name).string(), pic)) return fail(cmd, "cannot write " + (fs::path(a.out) / name).string());
     }
   char caption[160];
-  std::snprintf(caption, sizeof caption, "frame %d  %s  support %.2f  (%d hypotheses, %.0f + %.0f ms)", entry.frame,
-                result->found ? "found" : "NOT FOUND", result->best.support, static_cast<int>(result->hypotheses.size()),
-                result->match_ms, result->refine_ms);
+  std::snprintf(caption, sizeof caption, "frame %d  %s  support %.2f  runs on %.2f  (%d hypotheses, %.0f + %.0f ms)", entry.frame,
+                result->found ? "found" : "NOT FOUND", result->best.support, result->best.colour_continuation,
+                static_cast<int>(result->hypotheses.size()), result->match_ms, result->refine_ms);
   cv::putText(canvas, caption, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
   const std::string png_path = (fs::path(a.out) / "detection.png").string();
   if (!cv::imwrite(png_path, canvas)) return fail(cmd, "cannot write " + png_path);
@@ -191,8 +191,12 @@ int run_detect(const DetectArgs& a) {
               result->matches, result->hypotheses.size(), result->match_ms, result->refine_ms);
   if (const auto err = truth_error(result->best.cam_T_obj))
     std::printf("against gt.csv: %.2f deg, %.1f mm\n", err->first, err->second);
-  if (!result->found) return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + " (best support " +
-                                           std::to_string(result->best.support) + "); see " + png_path);
+  if (!result->found) {
+    char why[96];
+    std::snprintf(why, sizeof why, " (best support %.2f, its outline runs on %.2f, at most %.2f)", result->best.support,
+                  result->best.colour_continuation, a.detection.options.max_colour_continuation);
+    return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + why + "; see " + png_path);
+  }
   const std::string pose_path = (fs::path(a.out) / "pose.csv").string();
   if (auto ok = write_pose_csv(pose_path, {{entry.frame, entry.t_s, result->best.cam_T_obj, ""}}); !ok) return fail(cmd, ok.error());
   std::printf("wrote %s, %s, %s\n", pose_path.c_str(), json_path.c_str(), png_path.c_str());

@@ -91,7 +91,8 @@ struct DetectionResult {
   DetectionHypothesis best;
   int templates_matched = 0;   // templates the gravity filter left
   int matches = 0;             // LINE-2D matches above min_similarity
-  // Every refined hypothesis, best first: by score, those whose outline runs on last.
+  // Every refined hypothesis, best first: by score, those whose outline runs on after the
+  // others, those with no supported outline last.
   std::vector<DetectionHypothesis> hypotheses;
   double match_ms = 0, refine_ms = 0;
 };
