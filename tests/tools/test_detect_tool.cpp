@@ -63,15 +63,6 @@ TEST_CASE("detect finds the real tea box in the first frame from the model alone
   // The box stands in front of its background: past its corners the colours across its
   // outline's lines stop differing (0.18 measured here; a model laid on a facade, near 1).
   CHECK(j["best"]["colour_continuation"].get<double>() < 0.35);
-  // Hypotheses whose outline runs on past the object rank after the others that have a
-  // supported outline.
-  bool runs_on_seen = false;
-  for (const auto& h : j["hypotheses"]) {
-    if (h["score"].get<double>() <= 0) continue;  // no outline supported: ranked last
-    const bool runs_on = h["colour_continuation"].get<double>() > 0.6;
-    CHECK((runs_on || !runs_on_seen));
-    runs_on_seen = runs_on_seen || runs_on;
-  }
 
   // A limit below what the box shows refuses it: the limit decides what is found.
   const auto strict = run_epichead(tmp, "detect " + q(kTeabox) + " --frame 0 --out " + q(tmp / "strict") + kCache +

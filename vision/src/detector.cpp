@@ -242,13 +242,8 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
 
   const auto t1 = Clock::now();
   for (std::size_t i = 0; i < starts.size(); ++i) result.hypotheses.push_back(d.refine(starts[i], similarity[i]));
-  // Supported outlines that stop at the object first, then those that run on (not found, but
-  // what a user asks about when nothing was), then the unsupported.
-  const auto rank = [&d](const DetectionHypothesis& h) { return h.score <= 0 ? 2 : d.runs_on(h) ? 1 : 0; };
-  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(), [&rank](const DetectionHypothesis& a, const DetectionHypothesis& b) {
-    if (rank(a) != rank(b)) return rank(a) < rank(b);
-    return a.score > b.score;
-  });
+  std::stable_sort(result.hypotheses.begin(), result.hypotheses.end(),
+                   [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
   result.refine_ms += ms_since(t1);
   for (DetectionHypothesis& h : result.hypotheses) d.choose_symmetric(h, prior);
   if (!result.hypotheses.empty()) {

@@ -64,8 +64,9 @@ struct DetectorOptions {
   // their ends the colours differ at most this much, relative to across the lines along the
   // object (DetectionHypothesis::colour_continuation). A wire-frame laid on a building's facade
   // or windows finds its lines running on; an object in front of its background does not.
-  // Hypotheses whose outline runs on rank after the others.
-  double max_colour_continuation = 0.6;
+  // A test of the best hypothesis only: passing over it to the next one made wrong poses found
+  // where none was before (docs/detection.md).
+  double max_colour_continuation = 0.8;
 };
 
 // A pose found in one frame.
@@ -91,9 +92,7 @@ struct DetectionResult {
   DetectionHypothesis best;
   int templates_matched = 0;   // templates the gravity filter left
   int matches = 0;             // LINE-2D matches above min_similarity
-  // Every refined hypothesis, best first: by score, those whose outline runs on after the
-  // others, those with no supported outline last.
-  std::vector<DetectionHypothesis> hypotheses;
+  std::vector<DetectionHypothesis> hypotheses;  // every refined hypothesis, best score first
   double match_ms = 0, refine_ms = 0;
 };
 
