@@ -176,11 +176,14 @@ int run_detect(const DetectArgs& a) {
       std::snprintf(name, sizeof name, "hypothesis_%02zu.png", i);
       if (!cv::imwrite((fs::path(a.out) / name).string(), pic)) return fail(cmd, "cannot write " + (fs::path(a.out) / name).string());
     }
-  char caption[160];
-  std::snprintf(caption, sizeof caption, "frame %d  %s  support %.2f  runs on %.2f  (%d hypotheses, %.0f + %.0f ms)", entry.frame,
-                result->found ? "found" : "NOT FOUND", result->best.support, result->best.colour_continuation,
-                static_cast<int>(result->hypotheses.size()), result->match_ms, result->refine_ms);
+  // Two lines: one is wider than a 640 px frame.
+  char caption[96], timing[96];
+  std::snprintf(caption, sizeof caption, "frame %d  %s  support %.2f  runs on %.2f", entry.frame,
+                result->found ? "found" : "NOT FOUND", result->best.support, result->best.colour_continuation);
+  std::snprintf(timing, sizeof timing, "%d hypotheses, %.0f + %.0f ms", static_cast<int>(result->hypotheses.size()),
+                result->match_ms, result->refine_ms);
   cv::putText(canvas, caption, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
+  cv::putText(canvas, timing, {8, 36}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
   const std::string png_path = (fs::path(a.out) / "detection.png").string();
   if (!cv::imwrite(png_path, canvas)) return fail(cmd, "cannot write " + png_path);
 
