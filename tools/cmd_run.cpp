@@ -105,6 +105,9 @@ int run_onboard(const std::string& config_path, double seconds) {
   options.threads = head::VisionThreads::Thread;
   options.imu_clock_sync.max_round_trip_s = config->time_sync_max_round_trip_s;
   options.realtime = config->threads;
+  // The object's up when told: poses are checked against gravity from the start, and detection
+  // searches only upright views.
+  if (config->object_up) options.predictor.gravity_check.told_down_obj = -*config->object_up;
   auto loop = head::OnboardLoop::create(*model, *camera_model, options, ports);
   if (!loop) return fail(cmd, loop.error());
   // Detection: the start when no init_pose is given, and after every loss. Templates are read

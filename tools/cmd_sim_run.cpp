@@ -68,6 +68,7 @@ struct SimRunArgs {
   bool no_init = false;    // no start pose: detection finds the object
   bool reacquire = false;  // detection after a loss (always with no_init)
   DetectionArgs detection;
+  std::optional<Eigen::Vector3d> object_up_obj;  // detection.object_up, read
   // Where simulated time 0 lands in bus.log (Unix seconds, or "now"): a fixed date by default, so
   // that the same seed writes the same log; "now" lines a run up with today's logs.
   std::string log_epoch = std::to_string(head::kSimulatedLogEpochUnix_us / 1'000'000);
@@ -286,6 +287,9 @@ std::expected<head::OnboardSummary, std::string> run_once(const sim::Scenario& s
   const double told = a.told_backlash_rad >= 0 ? a.told_backlash_rad : scenario.head_dynamics.backlash_rad;
   o.controller.backlash = {told, told};
   o.processing_s = a.processing_ms * 1e-3;
+  // --object-up: the predictor checks the object's tilt against it from the start, and detection
+  // takes it as its gravity prior (through the predictor's down).
+  if (a.object_up_obj) o.predictor.gravity_check.told_down_obj = -*a.object_up_obj;
   const bool wall = a.threads == "wall";
   if (wall) o.threads = head::VisionThreads::Thread;  // processing_s is then what tracking really takes
   o.simulated_log_epoch_unix_us = a.log_epoch_unix_us;
@@ -402,6 +406,8 @@ int run_sim_run(const SimRunArgs& given) {
   SimRunArgs a = given;
   if (auto epoch = parse_log_epoch(a.log_epoch)) a.log_epoch_unix_us = *epoch;
   else return fail(cmd, epoch.error());
+  if (auto up = object_up(a.detection)) a.object_up_obj = *up;
+  else return fail(cmd, up.error());
   static const std::map<std::string, head::ControlMode> modes{
       {"fixate", head::ControlMode::Fixate}, {"stabilise", head::ControlMode::Stabilise}, {"hold", head::ControlMode::Hold}};
   const auto mode = modes.find(a.mode);

@@ -255,12 +255,13 @@ void warn_dropped_imu(const nlohmann::json& predictor) {
 // init set to it), or nothing when the object was not found.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> start_from_detection(Sequence& seq, TrackAcquisition& acquisition,
                                                                                  const cv::Mat& frame, const FrameEntry& entry,
-                                                                                 bool imu, std::optional<double> offset) {
+                                                                                 bool imu, std::optional<double> offset,
+                                                                                 const std::optional<Eigen::Vector3d>& up_obj) {
   const auto found = acquisition.find_start(frame, entry.frame, entry.t_s);
   if (!found) return std::unexpected(found.error());
   if (!*found) return std::unique_ptr<TrackPredictor>{};
   seq.set_init({entry.frame, entry.t_s, **found, ""});
-  return make_track_predictor(seq, imu, offset);
+  return make_track_predictor(seq, imu, offset, up_obj);
 }
 
 struct TrackCounts {
@@ -317,10 +318,11 @@ int run_track(const TrackArgs& args) {
   const auto offset = imu_time_offset(args.imu_time_offset);
   if (!offset) return fail(cmd, offset.error());
   if (args.imu == "on" && !seq->has_imu()) return fail(cmd, "--imu on: " + seq->dir() + " has no imu.csv");
-  if (const auto up = object_up(args.acquisition.detection); !up) return fail(cmd, up.error());
+  const auto up = object_up(args.acquisition.detection);
+  if (!up) return fail(cmd, up.error());
   // Without init.csv the predictor is made once detection has found the start.
   std::expected<std::unique_ptr<TrackPredictor>, std::string> predictor = std::unique_ptr<TrackPredictor>{};
-  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset);
+  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset, *up);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -370,7 +372,7 @@ int run_track(const TrackArgs& args) {
     const FrameEntry& entry = seq->frames()[i];
     if (!*predictor) {
       // No start yet: detect in this frame; frames before the start have no pose.
-      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset);
+      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset, *up);
       if (!started) return fail(cmd, started.error());
       if (!*started) {
         ++counts.searched_frames;

@@ -17,8 +17,10 @@ void add_detection_options(CLI::App& app, DetectionArgs& a) {
                  "$XDG_CACHE_HOME/epichead or ~/.cache/epichead)");
   app.add_flag("--no-cache", a.no_cache, "Build the detection templates without reading or writing the cache");
   app.add_option("--object-up", a.object_up,
-                 "The object's up direction in its model frame, x,y,z: with the IMU, gravity then removes two of "
-                 "the three rotation degrees of freedom from the detection search");
+                 "The object's up direction in its model frame, x,y,z, when it stands on its base: with the IMU, "
+                 "gravity then removes two of the three rotation degrees of freedom from the detection search, and "
+                 "track checks every pose's tilt against it from the first frame instead of learning the object's "
+                 "down from the poses");
   app.add_option("--distance-m", a.options.min_distance_m, "Detection: the nearest object distance to search, m (default from the model's size)")
       ->check(CLI::Range(0.0, 1e3));
   app.add_option("--max-distance-m", a.options.max_distance_m, "Detection: the farthest object distance to search, m")

@@ -100,6 +100,7 @@ std::vector<RunConfigKey> run_config_keys(const head::HeadControllerOptions& con
       {"init_pose", "string", "none"},
       {"template_cache", "string", "none"},
       {"reacquire", "boolean", d.reacquire ? "true" : "false"},
+      {"object_up", "array", "none"},
       {"mode", "string", json_string(d.mode)},
       {"out", "string", json_string(d.out)},
       {"camera.device", "string", json_string(d.camera.device)},
@@ -154,7 +155,7 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "camera_calibration is optional, with the default shown):\n"
          "  { \"model\": \"teabox/model.cao\", \"camera_calibration\": \"teabox/camera.yaml\",\n"
          "    \"init_pose\": \"teabox/init.csv\", \"template_cache\": \"~/.cache/epichead\",\n"
-         "    \"reacquire\": true,\n" +
+         "    \"reacquire\": true, \"object_up\": [0, 0, 1],\n" +
          std::string(devices) + "    \"controller\": { " + gains + " },\n    \"mode\": \"" + d.mode +
          "\",\n    \"out\": \"" + d.out +
          "\" }\n"
@@ -169,6 +170,9 @@ std::string run_config_help(const head::HeadControllerOptions& controller) {
          "by default $EPICHEAD_CACHE_DIR, else $XDG_CACHE_HOME/epichead, else ~/.cache/epichead;\n"
          "built once, with progress when stderr is a terminal); with reacquire it is detected again after a loss\n"
          "(docs/detection.md). reacquire false with an init_pose builds no templates.\n"
+         "object_up (none by default): the object's up in its model's frame when it stands on its base;\n"
+         "poses are then checked against gravity from the start instead of the down being learnt from them,\n"
+         "and detection searches upright views only (docs/fusion.md).\n"
          "A key not listed here is an error. Every key with its unit and meaning: docs/run_config.md.\n";
 }
 
@@ -202,6 +206,18 @@ std::expected<RunConfig, std::string> read_run_config(const std::string& path) {
     if (j.contains("reacquire")) {
       if (!j["reacquire"].is_boolean()) return std::unexpected(path + ": 'reacquire' must be true or false");
       c.reacquire = j["reacquire"].get<bool>();
+    }
+    if (j.contains("object_up")) {
+      const auto& up = j["object_up"];
+      bool ok = up.is_array() && up.size() == 3;
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; ok && i < 3; ++i) {
+        ok = up[i].is_number();
+        if (ok) v[static_cast<Eigen::Index>(i)] = up[i].get<double>();
+      }
+      if (!ok || !v.allFinite() || !(v.norm() > 1e-9))
+        return std::unexpected(path + ": 'object_up' must be [x, y, z], a non-zero direction in the model's frame");
+      c.object_up = v.normalized();
     }
     c.out = resolve(j.value("out", c.out));
     c.mode = j.value("mode", c.mode);

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "epichead/head/head_controller.h"
 #include "epichead/head/realtime_options.h"
 #include "epichead/head/device_clock_sync.h"
@@ -26,6 +28,7 @@ struct RunConfig {
   std::string init_pose;       // empty: the object is detected
   std::string template_cache;  // empty: vision::default_template_cache_dir()
   bool reacquire = true;       // detection after a loss (needs the templates)
+  std::optional<Eigen::Vector3d> object_up;  // unit, model frame: the object stands on its base this way up
   hw::V4l2CameraOptions camera;
   hw::SocketCanOptions can;
   double time_sync_max_round_trip_s = head::ClockSyncOptions{}.max_round_trip_s;  // "can": time_sync_max_round_trip_ms

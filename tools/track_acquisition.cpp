@@ -37,12 +37,14 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
   vision::DetectionPrior prior;
   prior.near_cam_T_obj = near;
   prior.orient_like = orient_like;
-  if (options_.use_imu_gravity && up_obj_) {
-    prior.up_obj = up_obj_;
-    prior.up_cam = up_from_imu(seq_->imu(), t_s);
-  } else if (upright) {
+  // The filter's down (the camera's mean acceleration taken off) before the accelerometer's plain
+  // mean, which the hand-held bursts that cause losses tilt by several degrees (docs/fusion.md).
+  if (upright) {
     prior.up_obj = upright->up_obj;
     prior.up_cam = upright->up_cam;
+  } else if (options_.use_imu_gravity && up_obj_) {
+    prior.up_obj = up_obj_;
+    prior.up_cam = up_from_imu(seq_->imu(), t_s);
   }
   const auto t0 = std::chrono::steady_clock::now();
   auto r = detector_->detect(frame, prior);
@@ -87,7 +89,10 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
     const Eigen::Vector3d u = predicted.linear() * upright->up_obj;
     if (std::atan2(u.cross(upright->up_cam).norm(), u.dot(upright->up_cam)) > upright->max_tilt_rad) near.reset();
   }
-  auto r = detect(frame, t_s, near, {}, upright);
+  // Even tilted, the prediction's turn about gravity is the gyro's: of the poses a symmetric model
+  // cannot tell apart (a box turned half round about its vertical, upright too), the one turned
+  // like it (box_clutter 151 with --object-up: the twin was taken, 98 -> 26 %).
+  auto r = detect(frame, t_s, near, predicted, upright);
   if (r && *r) {
     ++reacquired_;
     rechecks_due_.found_at(t_s);

@@ -258,6 +258,7 @@ class ImuPredictor final : public TrackPredictor {
             {"resumption_resets", c.resumption_resets},
             {"unaided_pose_floors", c.unaided_pose_floors},
             {"gravity_learnt", st.gravity_learnt},
+            {"gravity_told", st.gravity_told},
             {"learnt_down_obj", learnt_down_json()},
             {"vision_against_gravity", c.vision_against_gravity},
             {"gravity_forgotten", c.gravity_forgotten},
@@ -360,7 +361,8 @@ class ImuPredictor final : public TrackPredictor {
 }  // namespace
 
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s) {
+                                                                                 std::optional<double> imu_time_offset_s,
+                                                                                 const std::optional<Eigen::Vector3d>& object_up_obj) {
   if (use_imu) {
     if (!seq.has_imu()) return std::unexpected("--imu on: " + seq.dir() + " has no imu.csv");
     if (imu_time_offset_s && !std::isfinite(*imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
@@ -375,6 +377,7 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     if (!imu_time_offset_s) options.imu_time_offset_sigma_s = kUnknownOffsetSigmaS;
     // A body of revolution's poses turn freely about its axis: only the axis's tilt is checked.
     if (const auto axis = vision::find_revolution_axis(seq.model())) options.gravity_check.free_turn_axis_obj = axis->direction_obj.normalized();
+    if (object_up_obj) options.gravity_check.told_down_obj = -*object_up_obj;
     auto predictor = fusion::Predictor::create(options);
     if (!predictor) return std::unexpected("--imu on: " + predictor.error());
     std::optional<fusion::TimeOffsetEstimator> estimator;

@@ -75,7 +75,10 @@ class TrackPredictor {
 // runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset). Without a value
 // (auto) the offset starts at 0 and is estimated from the tracked poses and the gyro
 // (fusion/time_offset_estimator.h); once the estimate is confident the filter restarts with it.
+// object_up_obj (--object-up, unit): the object's up in its model frame when the user knows it;
+// the gravity check then takes its down from the first frame instead of learning it.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s);
+                                                                                 std::optional<double> imu_time_offset_s,
+                                                                                 const std::optional<Eigen::Vector3d>& object_up_obj);
 
 }  // namespace epichead::tools

@@ -8,12 +8,24 @@
 
 namespace epichead::fusion {
 
+LearntGravity::LearntGravity(const GravityCheckOptions& options) : options_(options) {
+  const auto& told = options_.told_down_obj;
+  if (told && told->allFinite() && told->norm() > 1e-9) {
+    down_obj_ = told->normalized();
+    learnt_ = told_ = true;
+  }
+}
+
 void LearntGravity::learn(double t_s, const Eigen::Vector3d& down_obj, double sigma_rad,
                           const Eigen::Vector3d& gyro_bias_radps, const Eigen::Vector3d& accel_bias_mps2,
                           int applied_in_a_row) {
   if (!options_.enabled || applied_in_a_row < options_.learn_after_applied || !(sigma_rad < options_.learn_sigma_rad) ||
       !down_obj.allFinite() || down_obj.norm() < 1e-9)
     return;
+  gyro_bias_radps_ = gyro_bias_radps;
+  accel_bias_mps2_ = accel_bias_mps2;
+  biases_learnt_ = true;
+  if (told_) return;  // the direction is the user's
   const Eigen::Vector3d d = down_obj.normalized();
   if (!learnt_) {
     down_obj_ = d;
@@ -21,8 +33,6 @@ void LearntGravity::learn(double t_s, const Eigen::Vector3d& down_obj, double si
     const double a = std::clamp((t_s - learnt_t_s_) / options_.learn_time_s, 0.0, 1.0);
     down_obj_ = ((1 - a) * down_obj_ + a * d).normalized();
   }
-  gyro_bias_radps_ = gyro_bias_radps;
-  accel_bias_mps2_ = accel_bias_mps2;
   learnt_ = true;
   learnt_t_s_ = t_s;
 }
@@ -54,7 +64,7 @@ void LearntGravity::note_verdict(double t_s, bool contradicts) {
   }
   if (contradicted_since_s_ < 0) contradicted_since_s_ = t_s;
   if (t_s - contradicted_since_s_ >= options_.forget_after_s) {
-    learnt_ = false;
+    learnt_ = told_ = false;
     contradicted_since_s_ = -1;
     ++forgotten_;
   }

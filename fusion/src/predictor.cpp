@@ -56,6 +56,8 @@ std::expected<void, std::string> check(const PredictorOptions& o) {
       !non_negative(g.min_window_s) || g.min_window_s > g.window_s || !positive(g.max_tilt_error_rad) ||
       !positive(g.forget_after_s))
     return bad("gravity_check", "needs learn_after_applied >= 1, 0 <= min_window_s <= window_s and the rest finite and > 0");
+  if (g.told_down_obj && !(g.told_down_obj->allFinite() && g.told_down_obj->norm() > 1e-9))
+    return bad("gravity_check.told_down_obj", "must be a finite, non-zero direction");
   const UnaidedOptions& u = o.unaided;
   if (!positive(u.after_s) || !positive(u.period_s) || !positive(u.down_sigma_rad) || !positive(u.max_force_error) ||
       !positive(u.position_sigma_m))
@@ -345,7 +347,7 @@ std::optional<Eigen::Vector3d> Predictor::measured_down_cam(double t_s) const {
   // The biases learnt with the down, else the newest state's, else none (a fraction of a degree
   // over the window either way).
   Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero();
-  if (gravity_.learnt()) {
+  if (gravity_.biases_learnt()) {
     bg = gravity_.gyro_bias_radps();
     ba = gravity_.accel_bias_mps2();
   } else if (const StateEntry* e = imu_.newest_state()) {
@@ -402,6 +404,7 @@ PredictorStatus Predictor::status(double now_t_s) const {
   PredictorStatus s = status_;
   s.initialised = initialised_;
   s.gravity_learnt = gravity_.learnt();
+  s.gravity_told = gravity_.told();
   s.coasting = initialised_ && options_.mode == PredictorMode::ImuAided &&
                (imu_.history().empty() || !(now_t_s - status_.newest_imu_t_s <= options_.coast_after_s));
   s.counters.repropagated_samples = imu_.repropagated_samples();

@@ -173,7 +173,7 @@ struct OnboardLoop::Impl {
     job.predicted = prediction ? prediction->cam_T_obj : last_good;
     // No start yet, or lost for a few frames: the stage looks for the object instead.
     job.detect = detector && (!have_pose || lost_run >= options.lost_frames_before_detection);
-    job.detect_near = job.detect && have_pose;
+    job.detect_near = job.orient_like_predicted = job.detect && have_pose;
     job.up_cam.reset();
     job.up_obj.reset();
     if (job.detect) {

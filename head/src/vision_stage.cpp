@@ -83,6 +83,7 @@ void VisionStage::track_job() {
 void VisionStage::detect_job(const cv::Mat& mat) {
   vision::DetectionPrior prior;
   if (job_.detect_near) prior.near_cam_T_obj = job_.predicted;
+  if (job_.orient_like_predicted) prior.orient_like = job_.predicted;
   prior.up_cam = job_.up_cam;
   prior.up_obj = job_.up_obj;
   const auto r = detector_->detect(mat, prior);

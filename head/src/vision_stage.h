@@ -41,8 +41,10 @@ struct VisionJob {
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
   hw::CameraFrame frame;                   // data points into the stage's own copy of the bytes
   // Find the object instead of tracking it (the stage's detector): near `predicted` first when
-  // detect_near, else over the whole search.
-  bool detect = false, detect_near = false;
+  // detect_near, else over the whole search. orient_like_predicted: of the poses a symmetric
+  // model cannot tell apart, the one turned like `predicted` (also when it is too tilted to
+  // search near: its turn about gravity is still the gyro's).
+  bool detect = false, detect_near = false, orient_like_predicted = false;
   // The world's up in the camera frame and the object's in its own (both known: the detection
   // keeps only poses that agree with them).
   std::optional<Eigen::Vector3d> up_cam, up_obj;

@@ -209,3 +209,65 @@ TEST_CASE("gravity_check options out of range are refused") {
   o.gravity_check.learn_after_applied = 0;
   CHECK_FALSE(Predictor::create(o));
 }
+
+TEST_CASE("a told down checks poses from the first frame, and a start tilted under the limit does not teach it another") {
+  // Poses all tilted by the same 8 deg in the object's frame: a wrong start the image supports
+  // (under the 10 deg limit) and the IMU cannot contradict, since it moves as the truth does.
+  const Trajectory traj;
+  const ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 4.0, 7);
+  const Eigen::Vector3d true_down = traj.params().gravity_dir_obj.normalized();
+  const Eigen::Matrix3d offset = Eigen::AngleAxisd(8 * deg, true_down.unitOrthogonal()).toRotationMatrix();
+  const auto tilted_start = [&](double t) {
+    Eigen::Isometry3d p = traj.at(t).x.cam_T_obj();
+    p.linear() = p.linear() * offset;
+    return p;
+  };
+  auto track = [&](const PredictorOptions& options) {
+    Predictor p = *Predictor::create(options);
+    std::size_t next = 0;
+    for (double t = 0.2; t < 3.0; t += 1.0 / 30) {
+      for (; next < imu.samples.size() && imu.samples[next].t_s <= t + 0.001; ++next) p.add_imu(imu.samples[next]);
+      p.add_vision(t, tilted_start(t), pose_cov(1e-3, 1e-3));
+    }
+    return p;
+  };
+  // Learnt: after 30 poses in a row the down is the tilted poses' (within the noise).
+  const Predictor learnt = track({});
+  REQUIRE(learnt.learnt_down_obj());
+  CHECK(angle_between(*learnt.learnt_down_obj(), offset.transpose() * true_down) < 1.0 * deg);
+  CHECK_FALSE(learnt.status(3.0).gravity_told);
+
+  PredictorOptions options;
+  options.gravity_check.told_down_obj = 2.5 * true_down;  // any length
+  Predictor told = *Predictor::create(options);
+  CHECK(told.learnt_down_obj());  // before any pose
+  const Predictor after = track(options);
+  REQUIRE(after.learnt_down_obj());
+  CHECK(angle_between(*after.learnt_down_obj(), true_down) < 1e-9);
+  CHECK(after.status(3.0).gravity_told);
+  // The right pose agrees with it, the start's pose is 8 deg off it.
+  const auto right = after.tilt_error_rad(2.9, traj.at(2.9).x.cam_T_obj());
+  const auto wrong = after.tilt_error_rad(2.9, tilted_start(2.9));
+  REQUIRE(right);
+  REQUIRE(wrong);
+  CHECK(*right < 1.5 * deg);
+  CHECK(std::abs(*wrong - 8 * deg) < 1.5 * deg);
+  // From the first frame: a pose 20 deg off is refused before the filter has ever started.
+  Predictor fresh = *Predictor::create(options);
+  for (const ImuSample& s : imu.samples)
+    if (s.t_s <= 0.5) fresh.add_imu(s);
+  const Eigen::Isometry3d truth = traj.at(0.5).x.cam_T_obj();
+  const Eigen::Isometry3d tilted20 = turned(truth, (truth.linear() * true_down).unitOrthogonal(), 20 * deg);
+  CHECK(fresh.add_vision(0.5, tilted20, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::AgainstGravity);
+  CHECK(fresh.add_vision(0.5, truth, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
+}
+
+TEST_CASE("a told down of zero length or not finite is refused") {
+  PredictorOptions options;
+  options.gravity_check.told_down_obj = Eigen::Vector3d::Zero();
+  const auto zero = Predictor::create(options);
+  REQUIRE_FALSE(zero);
+  CHECK(zero.error().find("told_down_obj") != std::string::npos);
+  options.gravity_check.told_down_obj = Eigen::Vector3d(0, 0, std::nan(""));
+  CHECK_FALSE(Predictor::create(options));
+}

@@ -122,6 +122,23 @@ TEST_CASE("run config: without init_pose the object is detected, reacquire is a 
   CHECK(bad_path.error().find("'init_pose' must be a string") != std::string::npos);
 }
 
+TEST_CASE("run config: object_up is a non-zero direction, read as a unit vector; none by default") {
+  TempDir dir;
+  CHECK_FALSE(read_run_config(write_config(dir, ""))->object_up);
+  const auto up = read_run_config(write_config(dir, R"("object_up": [0, 0, 2])"));
+  REQUIRE(up);
+  REQUIRE(up->object_up);
+  CHECK(up->object_up->isApprox(Eigen::Vector3d::UnitZ()));
+  for (const char* bad : {R"("object_up": [0, 0, 0])", R"("object_up": [0, 1])", R"("object_up": "up")",
+                          R"("object_up": [0, "1", 0])", R"("object_up": [0, 1, 0, 0])"}) {
+    INFO(bad);
+    const std::string path = write_config(dir, bad);
+    const auto c = read_run_config(path);
+    REQUIRE_FALSE(c);
+    CHECK(c.error().starts_with(path + ": 'object_up' must be [x, y, z]"));
+  }
+}
+
 namespace {
 
 // The rows of docs/run_config.md's key table: key, type, unit, default, meaning (backticks taken
@@ -169,7 +186,8 @@ TEST_CASE("run config: a file giving every documented key is read") {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& key : epichead::tools::run_config_keys(epichead::head::HeadControllerOptions{})) {
     nlohmann::json value;
-    if (key.default_json == "required" || key.default_json == "none") value = "some/file";
+    if (key.type == "array") value = {0, 0, 1};
+    else if (key.default_json == "required" || key.default_json == "none") value = "some/file";
     else value = nlohmann::json::parse(key.default_json);
     const std::size_t dot = key.name.find('.');
     if (dot == std::string::npos) j[key.name] = value;

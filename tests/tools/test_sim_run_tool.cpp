@@ -141,6 +141,10 @@ TEST_CASE("sim-run rejects bad input with one line naming the reason", "[tools][
   const auto scn = run_epichead(dir, "sim-run no_such_scene --out '" + dir.str() + "/o'");
   CHECK(scn.exit_code != 0);
   CHECK(scn.err.find("no_such_scene") != std::string::npos);
+  // The object's up is read before anything runs (it was once taken and never used).
+  const auto up = run_epichead(dir, "sim-run mockup_walk --out '" + dir.str() + "/o' --object-up 0,0,0");
+  CHECK(up.exit_code != 0);
+  CHECK(up.err.find("--object-up must be x,y,z, a non-zero direction") != std::string::npos);
 }
 
 TEST_CASE("sim-run --soak: the closed run alone, with memory and the predictor's attitude error reported",

@@ -1,7 +1,8 @@
 // `epichead track` on a held-out draw of a body of revolution: a lampshade simulated with a seed
 // no parameter was tuned on, tracked with the IMU, names the axis whose turn its edges cannot
 // show, scores within 5 cm / 5 deg once that turn is removed, and feeds the filter vision
-// updates; --free-turn off still tracks, and a bad --free-turn value is refused.
+// updates; --free-turn off still tracks, --object-up gives the gravity check its down from the
+// first frame, and a bad --free-turn value is refused.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -70,6 +71,26 @@ TEST_CASE("track --imu on follows a held-out lampshade, names its free turn's ax
   const auto off_report = nlohmann::json::parse(slurp(off + "/report.json"));
   CHECK(off_report["frames"] == 30);
   CHECK_FALSE(off_report.contains("free_turn_axis"));
+
+  // Told the shade's up, the filter checks tilts against it from the first frame (30 frames are
+  // too few to learn a down: 30 applied poses in a row are needed) and still tracks.
+  CHECK_FALSE(report["predictor"]["gravity_told"].get<bool>());
+  const std::string told = tmp / "track_told";
+  const auto up = run_epichead(tmp, "track " + q(seq) + " --out " + q(told) + " --imu on --object-up 0,0,1 --every 0 --no-video");
+  INFO(up.err);
+  REQUIRE(up.exit_code == 0);
+  const auto told_report = nlohmann::json::parse(slurp(told + "/report.json"));
+  const auto& predictor = told_report["predictor"];
+  INFO(predictor.dump());
+  CHECK(predictor["gravity_told"].get<bool>());
+  REQUIRE(predictor["learnt_down_obj"].size() == 3);
+  CHECK(predictor["learnt_down_obj"][2].get<double>() == Approx(-1.0));
+  std::size_t checked = 0;
+  for (const auto& f : told_report["per_frame"]) checked += f["tilt_error_deg"].is_number();
+  CHECK(checked >= 25);
+  const auto told_score = run_epichead(tmp, "score " + q(seq) + " " + q(told + "/poses.csv") + " --sym-axis 0,0,1 --json");
+  REQUIRE(told_score.exit_code == 0);
+  CHECK(nlohmann::json::parse(told_score.out)["success_rate"].get<double>() >= 0.97);
 }
 
 TEST_CASE("track refuses a --free-turn value other than auto or off with one line naming the option") {

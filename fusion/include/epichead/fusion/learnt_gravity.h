@@ -38,11 +38,16 @@ struct GravityCheckOptions {
   // A body of revolution (the tracker's free turn): its poses' turn about this axis (object
   // frame, unit) is arbitrary, so only the angle between the axis and the down is checked.
   std::optional<Eigen::Vector3d> free_turn_axis_obj;
+  // The object's down told by the user (object frame; a box standing on its base: minus its up).
+  // Then the down is known from the first frame instead of learnt from 30 applied poses, and a
+  // start that is wrong for a while cannot teach a wrong one (docs/fusion.md). Learning still
+  // takes the IMU biases. Forgotten like a learnt down (the object was moved), then learnt.
+  std::optional<Eigen::Vector3d> told_down_obj;
 };
 
 class LearntGravity {
  public:
-  explicit LearntGravity(const GravityCheckOptions& options) : options_(options) {}
+  explicit LearntGravity(const GravityCheckOptions& options);
 
   // After an applied vision pose at t_s: the filter's down in the object frame, its 1-sigma (rad),
   // its IMU biases, and how many poses it has applied in a row.
@@ -56,6 +61,10 @@ class LearntGravity {
   void note_verdict(double t_s, bool contradicts);
 
   bool learnt() const { return learnt_; }
+  // The down is the told one (not yet forgotten).
+  bool told() const { return told_; }
+  // gyro_bias_radps() and accel_bias_mps2() come from the filter (a told down has none at first).
+  bool biases_learnt() const { return biases_learnt_; }
   const Eigen::Vector3d& down_obj() const { return down_obj_; }
   // The learnt down for a pose that puts the measured down at `measured_down_obj` (object
   // frame): the learnt one, or with a free turn axis, of the downs at the learnt angle to the axis
@@ -69,6 +78,8 @@ class LearntGravity {
  private:
   GravityCheckOptions options_;
   bool learnt_ = false;
+  bool told_ = false;
+  bool biases_learnt_ = false;
   Eigen::Vector3d down_obj_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_mps2_ = Eigen::Vector3d::Zero();

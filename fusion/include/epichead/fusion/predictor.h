@@ -92,6 +92,7 @@ struct PredictorStatus {
   double last_nis = 0;             // normalised innovation squared of the last applied pose (6 dof)
   int gated_in_a_row = 0;
   bool gravity_learnt = false;     // check_tilt() can tell a tilted pose
+  bool gravity_told = false;       // ... by the down the user told (GravityCheckOptions::told_down_obj)
   PredictorCounters counters;
 };
 
