@@ -7,7 +7,7 @@
 # docs/results.md); each simulation's stderr goes to DIR/seq/<scenario>-<seed>.sim.log. On a
 # terminal, a progress line on stderr (sequences done, time taken, time left: tools/progress.sh).
 # Usage: tools/heldout.sh [--dev "1 2 3"] [--held "101 ... 110"] [--scenarios "a b"] [--frames N]
-#                         [--modes "m1 m2"] [--jobs J] [--out DIR]
+#                         [--modes "m1 m2"] [--object-up X,Y,Z] [--jobs J] [--out DIR]
 #   --dev, --held   seed lists (defaults: 1 2 3 and 101..112)
 #   --scenarios     default: every built-in scenario
 #   --frames N      simulate only the first N frames (default: the scenario's own)
@@ -15,6 +15,8 @@
 #                   has rows for these only
 #   --imu "on off"  which IMU settings to track with (default: both; "on" after a change
 #                   that only the IMU path sees)
+#   --object-up X,Y,Z  given to track: the object's up when told (every simulated object
+#                   stands on its base with its model's z up: 0,0,1); default: learnt
 #   --jobs J        sequences simulated and tracked at once (default: nproc)
 # Environment: EPICHEAD_BIN, the program to run (default: build/bin/epichead of this checkout).
 # Needs jq.
@@ -52,7 +54,8 @@ one() {
     for imu in "${imus[@]}"; do
       local dir="$out/track/$scenario-$seed/$mode-imu-$imu"
       mkdir -p "$dir"
-      if ! "$bin" track "$seq" --out "$dir" --mode "$mode" --imu "$imu" --every 0 --no-video > "$dir/log" 2>&1; then
+      if ! "$bin" track "$seq" --out "$dir" --mode "$mode" --imu "$imu" ${HELDOUT_OBJECT_UP:+--object-up "$HELDOUT_OBJECT_UP"} \
+        --every 0 --no-video > "$dir/log" 2>&1; then
         echo "heldout: track failed on $scenario seed $seed ($mode, imu $imu): $(tail -1 "$dir/log")" >&2
         continue
       fi
@@ -108,9 +111,10 @@ while (($#)); do
     --frames) frames="$2"; shift 2 ;;
     --modes) export HELDOUT_MODES="$2"; shift 2 ;;
     --imu) export HELDOUT_IMU="$2"; shift 2 ;;
+    --object-up) export HELDOUT_OBJECT_UP="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "heldout: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
