@@ -122,7 +122,7 @@ TEST_CASE("run config: without init_pose the object is detected, reacquire is a 
   CHECK(bad_path.error().find("'init_pose' must be a string") != std::string::npos);
 }
 
-TEST_CASE("run config: object_up is a non-zero direction, read as a unit vector; none by default") {
+TEST_CASE("run config: object_up is a non-zero direction, read as a unit vector, and none by default") {
   TempDir dir;
   CHECK_FALSE(read_run_config(write_config(dir, ""))->object_up);
   const auto up = read_run_config(write_config(dir, R"("object_up": [0, 0, 2])"));
