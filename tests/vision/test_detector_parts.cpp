@@ -1,6 +1,6 @@
 // The pieces of detection (vision/detector.h) that can be checked without a search: the view
 // sphere, the template cache's file format against bad bytes, edge support on drawn outlines,
-// and the model symmetries that scoring removes.
+// the model symmetries that scoring removes, and how the hypotheses' places are shared out.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -10,6 +10,7 @@
 
 #include "edge_drawing.h"
 #include "edge_support.h"
+#include "hypothesis_places.h"
 #include "epichead/vision/cao_model.h"
 #include "epichead/vision/model_symmetry.h"
 #include "epichead/vision/visibility.h"
@@ -270,4 +271,27 @@ TEST_CASE("of a pose and its symmetric equivalents, the prior chooses: the turn 
   CHECK((upright * Eigen::Vector3d::Zero() - truth * Eigen::Vector3d::Zero()).norm() < 1e-9);  // bottom where it is
   // No symmetries: the pose as found.
   CHECK(turn_deg(symmetric_nearest(found, {}, predicted), found) < 1e-9);
+}
+
+TEST_CASE("hypothesis places are shared out over the distances, what one leaves goes to the best of the rest") {
+  // Best first: ten at distance 0 (long outlines on dense texture), then the object's at
+  // distance 3. Eight places over four distances: two each at first.
+  std::vector<int> distance_of(10, 0);
+  distance_of.push_back(3);
+  const auto none_lie = [](std::size_t) { return false; };
+  const auto kept = hypothesis_places(distance_of, 4, 8, none_lie);
+  CHECK(kept == std::vector<std::size_t>{0, 1, 10, 2, 3, 4, 5, 6});  // the object's kept; the rest refilled best first
+  // Without the share (one distance), the object's would not be kept.
+  const auto unshared = hypothesis_places(std::vector<int>(11, 0), 1, 8, none_lie);
+  CHECK(std::find(unshared.begin(), unshared.end(), std::size_t{10}) == unshared.end());
+  // A candidate lying on a kept one takes no place, and is not asked about again.
+  int asked_about_1 = 0;
+  const auto deduped = hypothesis_places(distance_of, 4, 3, [&](std::size_t i) {
+    if (i == 1) ++asked_about_1;
+    return i == 1;
+  });
+  CHECK(deduped == std::vector<std::size_t>{0, 10, 2});  // one place per distance at first, then 1 (lies on 0) is passed over
+  CHECK(asked_about_1 == 1);
+  CHECK(hypothesis_places(distance_of, 4, 0, none_lie).empty());
+  CHECK(hypothesis_places({}, 4, 8, none_lie).empty());
 }

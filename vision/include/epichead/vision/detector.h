@@ -45,7 +45,8 @@ struct DetectorOptions {
   // Hypotheses: of the LINE-2D matches at or above min_similarity (percent), the best
   // max_candidates (shared out over the distances) are scored by the edge support of their
   // outline within candidate_radius_px at the template's pose; the best max_hypotheses of
-  // those, without duplicates, are refined and verified.
+  // those, without duplicates and again shared out over the distances (what one distance
+  // leaves goes to the best of the rest), are refined and verified.
   float min_similarity = 75.0f;
   int max_candidates = 2000;
   double candidate_radius_px = 4.0;
