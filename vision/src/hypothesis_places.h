@@ -18,12 +18,13 @@ template <class LiesOnKept>
 std::vector<std::size_t> hypothesis_places(const std::vector<int>& distance_of, int distances, int places, LiesOnKept&& lies_on_kept) {
   std::vector<std::size_t> kept;
   if (places <= 0) return kept;
-  const int per_distance = std::max(1, (places + std::max(1, distances) - 1) / std::max(1, distances));
-  std::vector<int> taken(static_cast<std::size_t>(std::max(1, distances)), 0);
+  const int n = std::max(1, distances);
+  const int per_distance = (places + n - 1) / n;  // >= 1, since places >= 1
+  std::vector<int> taken(static_cast<std::size_t>(n), 0);
   std::vector<char> seen(distance_of.size(), 0);
   for (int pass = 0; pass < 2; ++pass)
     for (std::size_t i = 0; i < distance_of.size() && static_cast<int>(kept.size()) < places; ++i) {
-      const auto d = static_cast<std::size_t>(std::clamp(distance_of[i], 0, static_cast<int>(taken.size()) - 1));
+      const auto d = static_cast<std::size_t>(std::clamp(distance_of[i], 0, n - 1));
       if (seen[i] || (pass == 0 && taken[d] >= per_distance)) continue;
       seen[i] = 1;
       if (lies_on_kept(i)) continue;
