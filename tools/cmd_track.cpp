@@ -444,6 +444,9 @@ int run_track(const TrackArgs& args) {
     if (args.imu == "on") vision_poses.push_back({entry.frame, entry.t_s, report.cam_T_obj, to_string(report.status)});
     if (report.status != TrackStatus::Lost) vision_covariances.push_back({entry.frame, entry.t_s, report.covariance});
     per_frame.push_back(frame_json(entry, report));
+    // How much of the frame was converted for the windows (window_image.h), tracking and any
+    // detection or recheck of this frame together.
+    per_frame.back()["image_share"] = static_cast<double>(image.tiles_prepared()) / image.tiles();
     if (use_image_motion) per_frame.back()["image_motion"] = image_motion.frame_json();
     if (tilt_error_rad) per_frame.back()["tilt_error_deg"] = *tilt_error_rad * 180 / std::numbers::pi;
 

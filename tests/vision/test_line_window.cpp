@@ -151,9 +151,7 @@ TEST_CASE("every vector path samples exactly what the scalar bilinear tap gives"
   cv::Mat img(90, 120, CV_8UC3);
   cv::RNG rng(5);
   rng.fill(img, cv::RNG::UNIFORM, 0, 256);
-  const WindowImage wi = to_window_image(img);
-  const int w = wi.width_px(), h = wi.height_px();
-  const float* px = wi.pixels();
+  const int w = img.cols, h = img.rows;
   // Both the SSE path and, where the CPU has it, the AVX2 one.
   for (const bool avx2 : {false, true}) {
     WindowOptions options;
@@ -166,7 +164,12 @@ TEST_CASE("every vector path samples exactly what the scalar bilinear tap gives"
         {{100.5, 10.25}, {20.75, 70.5}}, // right to left
     };
     for (const auto& [a, b] : lines) {
+      // A fresh image per window, whole only after sampling: a window that read a pixel it had
+      // not asked to be prepared would differ from the reference.
+      const WindowImage wi = to_window_image(img);
       REQUIRE(win.sample(wi, a, b));
+      wi.prepare_all();
+      const float* px = wi.pixels();
       const auto& g = win.geometry();
       const float ax = static_cast<float>(g.across.x()), ay = static_cast<float>(g.across.y());
       const float xmax = static_cast<float>(w - 1) - 1e-3f, ymax = static_cast<float>(h - 1) - 1e-3f;

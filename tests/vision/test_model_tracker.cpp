@@ -117,6 +117,36 @@ TEST_CASE("every mode follows a moving cube over clutter from a perturbed start"
   }
 }
 
+TEST_CASE("a frame converted tile by tile on demand tracks bit for bit as the whole frame converted") {
+  // Every reader of the window image must ask for the pixels it reads (window_image.h): one that
+  // did not would read the previous frame's values, or zeros, and its pose would differ.
+  const CadModel model = cube_model();
+  const Camera cam = test_camera();
+  for (TrackMode mode : {TrackMode::EpicValidation, TrackMode::Epic, TrackMode::Gradient}) {
+    CAPTURE(to_string(mode));
+    ModelTrackerOptions options;
+    options.mode = mode;
+    ModelTracker on_demand(model, cam, options), whole(model, cam, options);
+    WindowImage lazy_image, whole_image;
+    FrameReport lazy_report, whole_report;
+    Eigen::Isometry3d predicted = perturbed(pose_at(0));
+    for (int k = 0; k < 6; ++k) {
+      const cv::Mat frame = render(model, cam, pose_at(2 * k), true);
+      REQUIRE(lazy_image.assign(frame));
+      REQUIRE(whole_image.assign(frame));
+      whole_image.prepare_all();
+      on_demand.track(lazy_image, predicted, lazy_report);
+      whole.track(whole_image, predicted, whole_report);
+      CAPTURE(k);
+      CHECK(lazy_report.status == whole_report.status);
+      CHECK(lazy_report.cam_T_obj.matrix() == whole_report.cam_T_obj.matrix());
+      CHECK(lazy_report.covariance == whole_report.covariance);
+      CHECK(lazy_image.tiles_prepared() < lazy_image.tiles() / 2);  // the cube covers a small part of the frame
+      predicted = lazy_report.cam_T_obj;
+    }
+  }
+}
+
 TEST_CASE("the tracker says lost when the object is gone and re-acquired when it returns") {
   const CadModel model = cube_model();
   const Camera cam = test_camera();

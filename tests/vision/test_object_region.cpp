@@ -140,8 +140,11 @@ struct ReferenceRegion {
   bool ready = false;
 };
 
-ReferenceRegion reference_region(const WindowImage& image, const CadModel& model, const Camera& camera,
+ReferenceRegion reference_region(const WindowImage& frame_image, const CadModel& model, const Camera& camera,
                                  const Eigen::Isometry3d& cam_T_obj, const ObjectRegionOptions& o = {}) {
+  // A copy with every pixel converted: the region under test prepares its own pixels.
+  WindowImage image = frame_image;
+  image.prepare_all();
   ReferenceRegion r;
   const int w = image.width_px(), h = image.height_px();
   r.mask = cv::Mat::zeros(h, w, CV_8U);
@@ -261,6 +264,7 @@ TEST_CASE("the object region learns exactly what OpenCV's distance transforms ov
     pose.linear() = Eigen::AngleAxisd(rng.uniform(0.0, 2 * M_PI), Eigen::Vector3d(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)).normalized()).toRotationMatrix();
     const double z = rng.uniform(0.25, 0.9);
     pose.translation() = Eigen::Vector3d(rng.uniform(-0.6, 0.6) * z, rng.uniform(-0.45, 0.45) * z, z);
+    REQUIRE(image.assign(img));  // no pixel converted: learn() must ask for those it reads
     const ReferenceRegion expected = reference_region(image, model, kCamera, pose);
     INFO("trial " << trial);
     REQUIRE(region.learn(image, model, kCamera, pose) == expected.ready);

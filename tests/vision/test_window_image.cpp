@@ -1,7 +1,8 @@
 // WindowImage: every pixel's four channels equal their definition in window_image.h, computed
 // here the plain way (per pixel, clamped neighbours), for grey, BGR and BGRA frames of sizes
 // that exercise the borders (one pixel, one row, one column, odd sizes) and a full frame. The
-// conversion is split into vectorised passes; this holds them to the exact same numbers.
+// conversion is split into vectorised passes run tile by tile on demand; this holds them to the
+// exact same numbers whichever tiles are prepared, in whatever order.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -73,6 +74,7 @@ TEST_CASE("every channel of every pixel equals its definition, at the borders to
       const cv::Mat frame = random_frame(size[0], size[1], channels, 17 * size[0] + size[1] + channels);
       WindowImage image;
       REQUIRE(image.assign(frame));
+      image.prepare_all();
       const std::vector<float> expected = reference(frame);
       INFO(size[0] << " x " << size[1] << ", " << channels << " channels");
       CHECK(image.width_px() == size[0]);
@@ -93,16 +95,68 @@ TEST_CASE("a frame after a larger one is converted afresh and same-sized frames 
   REQUIRE(image.assign(random_frame(64, 48, 3, 1)));
   const cv::Mat small = random_frame(10, 6, 3, 2);
   REQUIRE(image.assign(small));
+  image.prepare_all();
   const std::vector<float> expected = reference(small);
   for (std::size_t i = 0; i < expected.size(); i += 4) REQUIRE(image.pixels()[i] == expected[i]);
   const cv::Mat grey = random_frame(64, 48, 1, 3), colour = random_frame(64, 48, 3, 4);
   REQUIRE(image.assign(grey));
+  image.prepare_all();
   REQUIRE(image.assign(colour));
+  image.prepare_all();
   const auto before = epichead::common::allocation_count();
-  const bool ok = image.assign(grey) && image.assign(colour);
+  bool ok = image.assign(grey).has_value();
+  image.prepare_all();
+  ok = image.assign(colour).has_value() && ok;
+  image.prepare_all();
   const auto after = epichead::common::allocation_count();  // before any assertion: Catch allocates
   REQUIRE(ok);
   CHECK(after == before);
+}
+
+TEST_CASE("tiles prepared one region at a time, in any order, hold the same values as the whole frame", "[window_image]") {
+  // Odd sizes: the last tile row and column are partial, and regions cross tile borders.
+  for (int channels : {1, 3, 4}) {
+    const cv::Mat frame = random_frame(101, 70, channels, 7 + channels);
+    const std::vector<float> expected = reference(frame);
+    WindowImage image;
+    REQUIRE(image.assign(random_frame(101, 70, channels, 99)));  // another frame first: nothing of it may stay
+    image.prepare_all();
+    REQUIRE(image.assign(frame));
+    CHECK(image.tiles() > 4);
+    CHECK(image.tiles_prepared() == 0);
+    cv::RNG rng(channels);
+    std::vector<unsigned char> covered(static_cast<std::size_t>(frame.cols) * frame.rows, 0);
+    for (int k = 0; k < 12; ++k) {
+      const int x = rng.uniform(-10, frame.cols), y = rng.uniform(-10, frame.rows);
+      const cv::Rect region(x, y, rng.uniform(1, 30), rng.uniform(1, 30));
+      image.prepare(region);
+      const cv::Rect in = region & cv::Rect(0, 0, frame.cols, frame.rows);
+      for (int yy = in.y; yy < in.y + in.height; ++yy)
+        for (int xx = in.x; xx < in.x + in.width; ++xx) covered[static_cast<std::size_t>(yy) * frame.cols + xx] = 1;
+    }
+    // A span's taps (and their right and lower neighbours), beyond the image at one end.
+    image.prepare_span(-5.5f, 40.2f, 20.7f, 64.9f);
+    for (int yy = 40; yy <= 65 && yy < frame.rows; ++yy)
+      for (int xx = 0; xx <= 21; ++xx) covered[static_cast<std::size_t>(yy) * frame.cols + xx] = 1;
+    INFO(channels << " channels");
+    CHECK(image.tiles_prepared() < image.tiles());
+    int wrong = 0;
+    for (std::size_t i = 0; i < covered.size(); ++i)
+      if (covered[i])
+        for (int c = 0; c < 4; ++c) wrong += image.pixels()[4 * i + c] != expected[4 * i + c];
+    CHECK(wrong == 0);
+    image.prepare_all();
+    CHECK(image.tiles_prepared() == image.tiles());
+    for (std::size_t i = 0; i < expected.size(); ++i) wrong += image.pixels()[i] != expected[i];
+    CHECK(wrong == 0);
+  }
+}
+
+TEST_CASE("a span with a non-finite end prepares the whole frame", "[window_image]") {
+  WindowImage image;
+  REQUIRE(image.assign(random_frame(80, 80, 3, 5)));
+  image.prepare_span(std::nanf(""), 3.0f, 10.0f, 10.0f);
+  CHECK(image.tiles_prepared() == image.tiles());
 }
 
 TEST_CASE("frames of other types are refused with the type named", "[window_image]") {

@@ -197,6 +197,8 @@ bool LineWindow::sample(const WindowImage& image, const Eigen::Vector2d& a_px, c
     const Eigen::Vector2d p0 = g.to_image(g.x_of_col(0), g.s_of_row(r));
     const float x0 = static_cast<float>(p0.x()), y0 = static_cast<float>(p0.y());
     const int base = r * g.cols;
+    const float last = static_cast<float>(g.cols - 1);
+    image.prepare_span(x0, y0, x0 + last * ax, y0 + last * ay);  // the columns' extremes, as computed below
     int c = 0;
 #if defined(__SSE4_1__)
     // The next row's source lines are requested while this row is interpolated: on a full-size

@@ -121,6 +121,7 @@ int ObjectRegion::count(const WindowImage& image, const cv::Rect& box, const cv:
   if (region.empty()) return 0;
   chamfer_distance(mask_, region, inside, distance_.data());
   const int stride = region.width + 2, w = image.width_px();
+  image.prepare(region);
   const float* px = image.pixels();
   int n = 0;
   // The grid's first row and column in region (every second pixel of box from its corner).

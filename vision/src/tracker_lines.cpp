@@ -124,6 +124,7 @@ bool TrackerLineWindow::sample(const WindowImage& image, const TrackerLine* line
     // A row is a segment: inside the image (with the +1 bilinear neighbour) when both ends are,
     // and then needs no clamp per pixel.
     const float xa = cx - half * nx, ya = cy - half * ny, xb = cx + half * nx, yb = cy + half * ny;
+    image.prepare_span(xa, ya, xb, yb);
     const bool inside = std::min(xa, xb) >= 0 && std::min(ya, yb) >= 0 && std::max(xa, xb) < xmax && std::max(ya, yb) < ymax;
     int c = 0;
 #if defined(__SSE4_1__)

@@ -6,23 +6,54 @@
 
 #include <opencv2/core.hpp>
 
+#include "avx2_clone.h"
+
 namespace epichead::vision {
 namespace {
 
-// Intensity and chromaticities of n pixels from byte planes. A free function with __restrict
-// arguments: bytes may alias anything, and as a member loop the compiler kept it scalar.
-void colour_planes(const std::uint8_t* __restrict blue, const std::uint8_t* __restrict green,
-                   const std::uint8_t* __restrict red, float* __restrict intensity, float* __restrict chroma_r,
-                   float* __restrict chroma_g, std::size_t n) {
+// Side of the square tiles the frame is converted by, px.
+constexpr int kTilePx = 32;
+
+// Intensity and chromaticities of one pixel (b, g, r as floats) into i, cr, cg.
+inline void colour_of(float b, float g, float r, float& i, float& cr, float& cg) {
   // Chromaticity offset k: (R+k)/(S+3k) tends to grey as S -> 0 instead of amplifying noise.
   constexpr float k = 8.0f;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float b = blue[i], g = green[i], r = red[i];
-    const float s = r + g + b;
-    const float inv = 255.0f / (s + 3.0f * k);
-    intensity[i] = s * (1.0f / 3.0f);
-    chroma_r[i] = (r + k) * inv;
-    chroma_g[i] = (g + k) * inv;
+  const float s = r + g + b;
+  const float inv = 255.0f / (s + 3.0f * k);
+  i = s * (1.0f / 3.0f);
+  cr = (r + k) * inv;
+  cg = (g + k) * inv;
+}
+
+// The runs below are also built for AVX2 (avx2_clone.h).
+
+// n pixels of interleaved BGR (3 bytes) or BGRA (4) into the three planes.
+EPICHEAD_AVX2_CLONE void colour_run_bgr(const std::uint8_t* __restrict bgr, float* __restrict intensity,
+                                        float* __restrict chroma_r, float* __restrict chroma_g, int n) {
+  for (int i = 0; i < n; ++i) colour_of(bgr[3 * i], bgr[3 * i + 1], bgr[3 * i + 2], intensity[i], chroma_r[i], chroma_g[i]);
+}
+EPICHEAD_AVX2_CLONE void colour_run_bgra(const std::uint8_t* __restrict bgra, float* __restrict intensity,
+                                         float* __restrict chroma_r, float* __restrict chroma_g, int n) {
+  for (int i = 0; i < n; ++i) colour_of(bgra[4 * i], bgra[4 * i + 1], bgra[4 * i + 2], intensity[i], chroma_r[i], chroma_g[i]);
+}
+
+// |dI/dx| + |dI/dy| halved, central differences, columns [a, b) with a >= 1 and b <= w - 1 (no
+// clamp), from the rows above, at and below.
+EPICHEAD_AVX2_CLONE void gradient_run(const float* __restrict up, const float* __restrict row, const float* __restrict down,
+                                      float* __restrict out, int a, int b) {
+  for (int x = a; x < b; ++x) out[x] = 0.5f * (std::fabs(row[x + 1] - row[x - 1]) + std::fabs(down[x] - up[x]));
+}
+
+// The 3x3 mean of the gradient rows r0, r1, r2 over columns [a, b) with a >= 1 and b <= w - 1,
+// interleaved with the planes I, R, G into dst (4 floats per pixel).
+EPICHEAD_AVX2_CLONE void texture_run(const float* __restrict r0, const float* __restrict r1, const float* __restrict r2,
+                                     const float* __restrict I, const float* __restrict R, const float* __restrict G,
+                                     float* __restrict dst, int a, int b) {
+  for (int x = a; x < b; ++x) {
+    dst[4 * x + 0] = I[x];
+    dst[4 * x + 1] = R[x];
+    dst[4 * x + 2] = G[x];
+    dst[4 * x + 3] = (r0[x - 1] + r0[x] + r0[x + 1] + r1[x - 1] + r1[x] + r1[x + 1] + r2[x - 1] + r2[x] + r2[x + 1]) * (1.0f / 9.0f);
   }
 }
 
@@ -39,88 +70,129 @@ std::expected<void, std::string> WindowImage::assign(const cv::Mat& frame) {
     intensity_.resize(n);
     chroma_r_.resize(n);
     chroma_g_.resize(n);
+    gradient_.resize(n);
   }
-  if (gradient_.size() < n) gradient_.resize(n);
   width_px_ = w;
   height_px_ = h;
   colour_ = frame.channels() >= 3;
-  convert_pixels(frame);
-  texture_gradient();
-  interleave_with_texture();
+  tiles_x_ = (w + kTilePx - 1) / kTilePx;
+  tiles_y_ = (h + kTilePx - 1) / kTilePx;
+  tile_ready_.assign(static_cast<std::size_t>(tiles_x_) * tiles_y_, 0);
+  tiles_prepared_ = 0;
+  keep_bytes(frame);
   return {};
 }
 
-// Intensity and chromaticity as planes (contiguous, so the arithmetic vectorises; the frame's
-// channels are first split into byte planes by OpenCV, which allocates nothing once sized).
-void WindowImage::convert_pixels(const cv::Mat& frame) {
-  const int w = width_px_, h = height_px_;
-  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  if (frame.channels() == 1) {
-    for (int y = 0; y < h; ++y) {
-      const std::uint8_t* src = frame.ptr<std::uint8_t>(y);
-      float* plane = intensity_.data() + static_cast<std::size_t>(y) * w;
-      for (int x = 0; x < w; ++x) plane[x] = src[x];
-    }
-    std::fill(chroma_r_.begin(), chroma_r_.begin() + static_cast<std::ptrdiff_t>(n), 85.0f);  // 255 / 3: grey
-    std::fill(chroma_g_.begin(), chroma_g_.begin() + static_cast<std::ptrdiff_t>(n), 85.0f);
+// The frame's bytes, as they are (a continuous copy: one memcpy for the usual frame).
+void WindowImage::keep_bytes(const cv::Mat& frame) {
+  channels_ = frame.channels();
+  const std::size_t n = static_cast<std::size_t>(width_px_) * static_cast<std::size_t>(height_px_) * channels_;
+  if (bytes_.size() < n) bytes_.resize(n);
+  cv::Mat copy(height_px_, width_px_, frame.type(), bytes_.data());
+  frame.copyTo(copy);
+}
+
+void WindowImage::prepare(const cv::Rect& region) const {
+  const cv::Rect r = region & cv::Rect(0, 0, width_px_, height_px_);
+  if (r.empty()) return;
+  const int tx1 = (r.x + r.width - 1) / kTilePx, ty1 = (r.y + r.height - 1) / kTilePx;
+  for (int ty = r.y / kTilePx; ty <= ty1; ++ty)
+    for (int tx = r.x / kTilePx; tx <= tx1; ++tx)
+      if (!tile_ready_[static_cast<std::size_t>(ty) * tiles_x_ + tx]) prepare_tile(tx, ty);
+}
+
+void WindowImage::prepare_span(float xa, float ya, float xb, float yb) const {
+  if (!(std::isfinite(xa) && std::isfinite(ya) && std::isfinite(xb) && std::isfinite(yb))) {
+    prepare_all();  // a caller that samples such a span clamps it somewhere in the image
     return;
   }
-  if (bgr_.size() < 3 * n) bgr_.resize(3 * n);
-  cv::Mat planes[3] = {cv::Mat(h, w, CV_8UC1, bgr_.data()), cv::Mat(h, w, CV_8UC1, bgr_.data() + n),
-                       cv::Mat(h, w, CV_8UC1, bgr_.data() + 2 * n)};
-  constexpr int kFromTo[] = {0, 0, 1, 1, 2, 2};  // B, G, R (a fourth channel, alpha, is left out)
-  cv::mixChannels(&frame, 1, planes, 3, kFromTo, 3);
-  colour_planes(bgr_.data(), bgr_.data() + n, bgr_.data() + 2 * n, intensity_.data(), chroma_r_.data(), chroma_g_.data(), n);
+  // Clamped as a window clamps its taps (into [0, size - 1)), then the tap's pixel and its
+  // right and lower neighbours.
+  const float xmax = static_cast<float>(width_px_ - 1), ymax = static_cast<float>(height_px_ - 1);
+  const int x0 = static_cast<int>(std::clamp(std::min(xa, xb), 0.0f, xmax));
+  const int x1 = static_cast<int>(std::clamp(std::max(xa, xb), 0.0f, xmax)) + 1;
+  const int y0 = static_cast<int>(std::clamp(std::min(ya, yb), 0.0f, ymax));
+  const int y1 = static_cast<int>(std::clamp(std::max(ya, yb), 0.0f, ymax)) + 1;
+  prepare(cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
 }
 
-// |dI/dx| + |dI/dy| by central differences, the border replicated. The interior loop has no
-// clamps, so it vectorises; the per-pixel arithmetic is the same at the border and inside.
-void WindowImage::texture_gradient() {
+// A tile's four channels. The texture's 3x3 mean needs the gradient one pixel around the tile,
+// which needs the intensity two pixels around it: those margins are computed again for each
+// tile that needs them (the same values each time), which costs less than tracking which of
+// them a neighbouring tile already made.
+void WindowImage::prepare_tile(int tx, int ty) const {
+  const int w = width_px_, h = height_px_;
+  const int x0 = tx * kTilePx, x1 = std::min(w, x0 + kTilePx);
+  const int y0 = ty * kTilePx, y1 = std::min(h, y0 + kTilePx);
+  for (int y = std::max(y0 - 2, 0); y < std::min(y1 + 2, h); ++y) colour_row(y, std::max(x0 - 2, 0), std::min(x1 + 2, w));
+  for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, h); ++y) gradient_row(y, std::max(x0 - 1, 0), std::min(x1 + 1, w));
+  for (int y = y0; y < y1; ++y) interleave_row(y, x0, x1);
+  tile_ready_[static_cast<std::size_t>(ty) * tiles_x_ + tx] = 1;
+  ++tiles_prepared_;
+}
+
+// Intensity and chromaticity of row y, columns [x0, x1).
+void WindowImage::colour_row(int y, int x0, int x1) const {
+  const std::size_t at = static_cast<std::size_t>(y) * width_px_ + x0;
+  const std::uint8_t* src = bytes_.data() + at * channels_;
+  float* I = intensity_.data() + at;
+  float* R = chroma_r_.data() + at;
+  float* G = chroma_g_.data() + at;
+  const int n = x1 - x0;
+  switch (channels_) {
+    case 3: colour_run_bgr(src, I, R, G, n); return;
+    case 4: colour_run_bgra(src, I, R, G, n); return;
+    default:
+      for (int i = 0; i < n; ++i) I[i] = src[i];
+      std::fill_n(R, n, 85.0f);  // 255 / 3: grey
+      std::fill_n(G, n, 85.0f);
+  }
+}
+
+// |dI/dx| + |dI/dy| (halved) by central differences of row y, columns [x0, x1), the border
+// replicated. The interior run has no clamps, so it vectorises; the per-pixel arithmetic is the
+// same at the border and inside.
+void WindowImage::gradient_row(int y, int x0, int x1) const {
   const int w = width_px_, h = height_px_;
   const float* I = intensity_.data();
-  auto at = [&](int x, int y) { return I[static_cast<std::size_t>(y) * w + x]; };
-  for (int y = 0; y < h; ++y) {
-    const float* __restrict up = I + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
-    const float* __restrict row = I + static_cast<std::size_t>(y) * w;
-    const float* __restrict down = I + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
-    float* __restrict out = gradient_.data() + static_cast<std::size_t>(y) * w;
-    auto border = [&](int x) {
-      const int xm = std::max(x - 1, 0), xp = std::min(x + 1, w - 1);
-      out[x] = 0.5f * (std::fabs(at(xp, y) - at(xm, y)) + std::fabs(down[x] - up[x]));
-    };
-    border(0);
-    for (int x = 1; x < w - 1; ++x) out[x] = 0.5f * (std::fabs(row[x + 1] - row[x - 1]) + std::fabs(down[x] - up[x]));
-    if (w > 1) border(w - 1);
-  }
+  const float* __restrict up = I + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
+  const float* __restrict row = I + static_cast<std::size_t>(y) * w;
+  const float* __restrict down = I + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
+  float* __restrict out = gradient_.data() + static_cast<std::size_t>(y) * w;
+  auto border = [&](int x) {
+    const int xm = std::max(x - 1, 0), xp = std::min(x + 1, w - 1);
+    out[x] = 0.5f * (std::fabs(row[xp] - row[xm]) + std::fabs(down[x] - up[x]));
+  };
+  if (x0 == 0) border(0);
+  gradient_run(up, row, down, out, std::max(x0, 1), std::min(x1, w - 1));
+  if (x1 == w && w > 1) border(w - 1);
 }
 
-// The 3x3 mean of the gradient (the texture), the border replicated, interleaved with the three
-// planes into pixels_. The nine terms are summed in the same order everywhere, so the interior
-// (vectorised: the four stores form one group) and the border agree.
-void WindowImage::interleave_with_texture() {
+// The 3x3 mean of the gradient (the texture) of row y, columns [x0, x1), the border replicated,
+// interleaved with the three planes into pixels_. The nine terms are summed in the same order
+// everywhere, so the interior (vectorised: the four stores form one group) and the border agree.
+void WindowImage::interleave_row(int y, int x0, int x1) const {
   const int w = width_px_, h = height_px_;
-  for (int y = 0; y < h; ++y) {
-    const std::size_t row = static_cast<std::size_t>(y) * w;
-    const float* __restrict r0 = gradient_.data() + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
-    const float* __restrict r1 = gradient_.data() + row;
-    const float* __restrict r2 = gradient_.data() + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
-    const float* __restrict I = intensity_.data() + row;
-    const float* __restrict R = chroma_r_.data() + row;
-    const float* __restrict G = chroma_g_.data() + row;
-    float* __restrict dst = pixels_.data() + 4 * row;
-    auto mean = [&](int xm, int x, int xp) {
-      return (r0[xm] + r0[x] + r0[xp] + r1[xm] + r1[x] + r1[xp] + r2[xm] + r2[x] + r2[xp]) * (1.0f / 9.0f);
-    };
-    auto put = [&](int x, float texture) {
-      dst[4 * x + 0] = I[x];
-      dst[4 * x + 1] = R[x];
-      dst[4 * x + 2] = G[x];
-      dst[4 * x + 3] = texture;
-    };
-    put(0, mean(0, 0, std::min(1, w - 1)));
-    for (int x = 1; x < w - 1; ++x) put(x, mean(x - 1, x, x + 1));
-    if (w > 1) put(w - 1, mean(w - 2, w - 1, w - 1));
-  }
+  const std::size_t row = static_cast<std::size_t>(y) * w;
+  const float* __restrict r0 = gradient_.data() + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
+  const float* __restrict r1 = gradient_.data() + row;
+  const float* __restrict r2 = gradient_.data() + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
+  const float* __restrict I = intensity_.data() + row;
+  const float* __restrict R = chroma_r_.data() + row;
+  const float* __restrict G = chroma_g_.data() + row;
+  float* __restrict dst = pixels_.data() + 4 * row;
+  auto mean = [&](int xm, int x, int xp) {
+    return (r0[xm] + r0[x] + r0[xp] + r1[xm] + r1[x] + r1[xp] + r2[xm] + r2[x] + r2[xp]) * (1.0f / 9.0f);
+  };
+  auto put = [&](int x, float texture) {
+    dst[4 * x + 0] = I[x];
+    dst[4 * x + 1] = R[x];
+    dst[4 * x + 2] = G[x];
+    dst[4 * x + 3] = texture;
+  };
+  if (x0 == 0) put(0, mean(0, 0, std::min(1, w - 1)));
+  texture_run(r0, r1, r2, I, R, G, dst, std::max(x0, 1), std::min(x1, w - 1));
+  if (x1 == w && w > 1) put(w - 1, mean(w - 2, w - 1, w - 1));
 }
 
 }  // namespace epichead::vision
