@@ -131,11 +131,7 @@ bool levenberg_marquardt(const PoseTerms& terms, const PoseProblem& problem, con
     const Tukey kernel(c);
     terms.normal_equations(pose, kernel, ne);
     if (!ne.H.allFinite() || !ne.g.allFinite()) return false;
-    auto cost_at = [&](const Eigen::Isometry3d& p) {
-      double sum = 0;
-      terms.residuals(p, Rejected::Skip, [&](double r, int) { sum += kernel.rho(r); });
-      return sum;
-    };
+    auto cost_at = [&](const Eigen::Isometry3d& p) { return terms.cost(p, kernel); };
     bool improved = false;
     Vector6d step = Vector6d::Zero();
     const StepBasis basis = step_basis(problem, pose);

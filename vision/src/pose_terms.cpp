@@ -8,6 +8,17 @@
 
 namespace epichead::vision::detail {
 
+void add_line_cost(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
+                   const Tukey& k, double& sum) {
+  EdgelChunk chunk;
+  const int total = static_cast<int>(obs.edgels_px.size());
+  for (int first = 0; first < total; first += kEdgelChunk) {
+    const int n = std::min(kEdgelChunk, total - first);
+    line_edgel_values(obs, img, xns + first, n, focal, &k, false, chunk);
+    for (int q = 0; q < n; ++q) sum += chunk.rho[q];
+  }
+}
+
 // A line's residuals depend on the pose only through its image line l, so r_k = f(l, x_k) and
 // J_k = (dr_k/dl)^T dl/dxi with one 3x6 dl/dxi per line: the edgels accumulate the 3x3
 // sum w (dr/dl)(dr/dl)^T and the 3-vector sum w r dr/dl, and the 6x6 is formed once per line
@@ -18,35 +29,46 @@ void add_line_block(const LineObservation& obs, const LineImage& img, const Eige
   const bool shared_errors = shared_sigma_px >= 0;
   const Eigen::Vector3d& l = img.l;
   const double s = img.s;
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  // M (column-major, as Eigen's) and v, summed edgel by edgel. No skip at w = 0: a non-finite
+  // row must still reach H.
+  double m[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, v0 = 0, v1 = 0, v2 = 0;
   // For the shared errors: sums of w dr/dl and of w t dr/dl with t the edgel's place along the
   // line (normalised coordinates), of w and w t, and t's extent.
   Eigen::Vector3d s0 = Eigen::Vector3d::Zero(), s1 = Eigen::Vector3d::Zero();
   double w0 = 0, wt = 0, t_min = 0, t_max = 0;
   const Eigen::Vector2d along(-l.y() / s, l.x() / s);
-  for (std::size_t q = 0; q < obs.edgels_px.size(); ++q) {
-    const double r = line_residual(obs, img, xns[q], focal);
-    const double w = k.weight(r);  // no skip at w = 0: a non-finite row must still reach H
-    ne.cost += k.rho(r);
-    const Eigen::Vector3d x(xns[q].x(), xns[q].y(), 1);
-    const double ldx = l.dot(x);
-    // dr/dl, the same expression (and values) as the per-edgel Jacobian had.
-    const Eigen::Vector3d dr_dl = (x / s - ldx / (s * s * s) * Eigen::Vector3d(l.x(), l.y(), 0)) * focal / obs.sigma_px;
-    M.noalias() += (w * dr_dl) * dr_dl.transpose();
-    v += (w * r) * dr_dl;
-    ne.wr2 += w * r * r;
-    ne.wsum += w;
-    if (shared_errors) {
-      const double t = along.dot(xns[q]);
-      s0 += w * dr_dl;
-      s1 += (w * t) * dr_dl;
-      w0 += w;
-      wt += w * t;
-      t_min = q ? std::min(t_min, t) : t;
-      t_max = q ? std::max(t_max, t) : t;
+  EdgelChunk chunk;
+  const int total = static_cast<int>(obs.edgels_px.size());
+  for (int first = 0; first < total; first += kEdgelChunk) {
+    const int n = std::min(kEdgelChunk, total - first);
+    line_edgel_values(obs, img, xns + first, n, focal, &k, true, chunk);
+    for (int q = 0; q < n; ++q) {
+      const double r = chunk.r[q], w = chunk.w[q];
+      const double d[3] = {chunk.d0[q], chunk.d1[q], chunk.d2[q]};
+      const double wd[3] = {w * d[0], w * d[1], w * d[2]};
+      ne.cost += chunk.rho[q];
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) m[3 * j + i] += wd[i] * d[j];
+      const double wr = w * r;
+      v0 += wr * d[0];
+      v1 += wr * d[1];
+      v2 += wr * d[2];
+      ne.wr2 += w * r * r;
+      ne.wsum += w;
+      if (shared_errors) {
+        const Eigen::Vector3d dr_dl(d[0], d[1], d[2]);
+        const double t = along.dot(xns[first + q]);
+        s0 += w * dr_dl;
+        s1 += (w * t) * dr_dl;
+        w0 += w;
+        wt += w * t;
+        t_min = first + q ? std::min(t_min, t) : t;
+        t_max = first + q ? std::max(t_max, t) : t;
+      }
     }
   }
+  const Eigen::Map<const Eigen::Matrix3d> M(m);
+  const Eigen::Vector3d v(v0, v1, v2);
   // dl/dxi of l = A x B under a left perturbation of the pose: dA = [I | -[A]x] dxi (same for
   // B), so dl = [A - B]x dt - [l]x dphi (using [B]x[A]x - [A]x[B]x = [B x A]x).
   Eigen::Matrix<double, 3, 6> dl;
@@ -75,6 +97,17 @@ Eigen::Matrix3d circle_conic_normalized(const ModelCircle& circle, const Eigen::
   Q << circle.radius_m * u, circle.radius_m * v, c;
   const Eigen::Matrix3d Qi = Q.inverse();
   return Qi.transpose() * Eigen::Vector3d(1, 1, -1).asDiagonal() * Qi;
+}
+
+double PoseTerms::cost(const Eigen::Isometry3d& cam_T_obj, const Tukey& k) const {
+  double sum = 0;
+  for (std::size_t i = 0; i < problem_.lines.size(); ++i) {
+    const LineObservation& obs = problem_.lines[i];
+    if (obs.edgels_px.size() < 2 || skip(static_cast<int>(i), Rejected::Skip)) continue;
+    add_line_cost(obs, line_image(obs, cam_T_obj), line_edgels(i), focal_, k, sum);
+  }
+  rows(cam_T_obj, Rejected::Skip, false, [&](double r, const RowJ&, int) { sum += k.rho(r); });
+  return sum;
 }
 
 void PoseTerms::normal_equations(const Eigen::Isometry3d& cam_T_obj, const Tukey& k, NormalEquations& ne,

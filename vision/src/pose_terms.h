@@ -10,6 +10,7 @@
 //  - junction: the reprojection error of a model vertex, in pixels;
 //  - ellipse point: the first-order geometric distance from the image conic of a model circle;
 //  - 3D point: the difference of a model vertex from its measurement in the camera frame.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -89,11 +90,40 @@ inline double line_residual(const LineObservation& obs, const LineImage& img, co
   return focal * img.l.dot(Eigen::Vector3d(xn.x(), xn.y(), 1)) / img.s / obs.sigma_px;
 }
 
+// A line's edgels are taken kEdgelChunk at a time: first each edgel's own values (residual,
+// Tukey weight and cost, dr/dl), element-wise with no sums, so that the loop vectorises; then the
+// sums, in edgel order. The values are line_residual's and add_line_block's expressions term by
+// term, so the totals are those of one loop doing both (tests/vision/test_pose_estimator.cpp
+// holds them to that, bit for bit).
+inline constexpr int kEdgelChunk = 64;
+
+struct EdgelChunk {
+  alignas(32) double r[kEdgelChunk];
+  alignas(32) double w[kEdgelChunk];    // Tukey weight (with_derivatives only)
+  alignas(32) double rho[kEdgelChunk];  // Tukey cost (with a kernel only)
+  alignas(32) double d0[kEdgelChunk], d1[kEdgelChunk], d2[kEdgelChunk];  // dr/dl (with_derivatives only)
+};
+
+// The values of n <= kEdgelChunk edgels xns of a line: residuals always; with `k`, the Tukey
+// cost; with_derivatives (needs k), the weight and dr/dl too.
+void line_edgel_values(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, int n, double focal,
+                       const Tukey* k, bool with_derivatives, EdgelChunk& out);
+
 // fn(r) for each of the line's edgels (xns: its undistorted edgels).
 template <class Fn>
 void line_residuals(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal, Fn&& fn) {
-  for (std::size_t k = 0; k < obs.edgels_px.size(); ++k) fn(line_residual(obs, img, xns[k], focal));
+  EdgelChunk chunk;
+  const int total = static_cast<int>(obs.edgels_px.size());
+  for (int first = 0; first < total; first += kEdgelChunk) {
+    const int n = std::min(kEdgelChunk, total - first);
+    line_edgel_values(obs, img, xns + first, n, focal, nullptr, false, chunk);
+    for (int q = 0; q < n; ++q) fn(chunk.r[q]);
+  }
 }
+
+// Tukey's cost summed over the line's edgels onto sum, in edgel order.
+void add_line_cost(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
+                   const Tukey& k, double& sum);
 
 // The line's block of the normal equations, formed once per line rather than once per edgel.
 void add_line_block(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
@@ -187,6 +217,10 @@ class PoseTerms {
     }
     rows(cam_T_obj, which, false, [&](double r, const RowJ&, int s) { fn(r, s); });
   }
+
+  // Tukey's cost at cam_T_obj summed over every residual in slot order (residuals() with
+  // k.rho summed, the lines' edgels element-wise first); rejected features left out.
+  double cost(const Eigen::Isometry3d& cam_T_obj, const Tukey& k) const;
 
   // The normal equations at cam_T_obj under kernel k, from scratch; rejected features left out.
   // With shared errors (shared_sigma_px >= 0: PoseOptions::line_shared_sigma_px) also
