@@ -87,12 +87,20 @@ TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the track
   CHECK(report["predictor"]["imu_time_offset_s"].get<double>() ==
         Approx(truth["imu"]["clock_offset_s"].get<double>()).margin(0.003));
   CHECK(report["lost"].get<int>() == 0);
-  // A given offset is used as it is.
+  CHECK(run.out.find("camera-IMU time offset estimated: ") != std::string::npos);  // the user is told
+  // A given offset is used as it is, and nothing is said about it.
   const auto fixed = run_epichead(tmp, "track " + q(seq) + " --out " + q(tmp / "fixed") + " --imu on --imu-time-offset-s 0.01 --every 0 --no-video");
   REQUIRE(fixed.exit_code == 0);
   const auto fr = nlohmann::json::parse(slurp(tmp / "fixed/report.json"));
   CHECK(fr["predictor"]["imu_time_offset_s"].get<double>() == 0.01);
   CHECK(fr["predictor"]["imu_time_offset_estimate"].is_null());
+  CHECK(fixed.out.find("time offset") == std::string::npos);
+  CHECK(fixed.err.find("time offset") == std::string::npos);
+  // Too short a run to estimate it: said on stderr, with the way out.
+  const auto brief = run_epichead(tmp, "track " + q(seq) + " --out " + q(tmp / "brief") + " --imu on --frames 20 --every 0 --no-video");
+  REQUIRE(brief.exit_code == 0);
+  CHECK(brief.err.find("time offset could not be estimated") != std::string::npos);
+  CHECK(brief.err.find("--imu-time-offset-s") != std::string::npos);
 }
 
 TEST_CASE("track --imu on writes the filter's estimate, which rides out the poses of blurred shakes") {
