@@ -18,62 +18,53 @@
 namespace epichead::bench {
 namespace {
 
-struct TrackCycle {
+// What an iteration starts from: window images made before the clock (track_cycle), or the
+// frame itself, taken into one window image per iteration (track_frame, and with every tile
+// converted first, track_frame_whole).
+enum class Start { ConvertedImage, FrameOnDemand, FrameWhole };
+
+struct TrackBench {
   std::unique_ptr<vision::Sequence> seq;
   std::unique_ptr<vision::ModelTracker> tracker;
-  std::vector<vision::WindowImage> images;
+  std::vector<cv::Mat> frames;
+  std::vector<vision::WindowImage> images;  // ConvertedImage: one per frame
+  vision::WindowImage image;                // otherwise: the one the frames are taken into
   std::vector<Eigen::Isometry3d> truth;
   vision::FrameReport report;
   std::size_t next = 0;
 };
 
-const Registration track_cycle{"track_cycle", [] {
+Iteration track_bench(Start start) {
   SimulatedSequence sim = simulate_builtin("mockup_walk", 24);
-  auto s = std::make_shared<TrackCycle>();
+  auto s = std::make_shared<TrackBench>();
   s->seq = std::move(sim.seq);
-  s->images.resize(sim.frames.size());
-  for (std::size_t i = 0; i < s->images.size(); ++i) {
-    if (auto ok = s->images[i].assign(sim.frames[i]); !ok) throw std::runtime_error(ok.error());
-    s->truth.push_back(s->seq->ground_truth()[i].cam_T_obj);
+  s->frames = std::move(sim.frames);
+  for (std::size_t i = 0; i < s->frames.size(); ++i) s->truth.push_back(s->seq->ground_truth()[i].cam_T_obj);
+  if (start == Start::ConvertedImage) {
+    s->images.resize(s->frames.size());
+    for (std::size_t i = 0; i < s->images.size(); ++i)
+      if (auto ok = s->images[i].assign(s->frames[i]); !ok) throw std::runtime_error(ok.error());
   }
   s->tracker = std::make_unique<vision::ModelTracker>(s->seq->model(), s->seq->camera());
   // Each frame is predicted at the previous frame's true pose (the motion of one frame
   // interval is left for the windows to find), so the work is that of real tracking.
-  return [s] {
-    const std::size_t i = s->next;
-    s->next = (i + 1) % s->images.size();
-    s->tracker->track(s->images[i], s->truth[i == 0 ? 0 : i - 1], s->report);
-  };
-}};
-
-struct TrackFrame {
-  std::unique_ptr<vision::Sequence> seq;
-  std::unique_ptr<vision::ModelTracker> tracker;
-  std::vector<cv::Mat> frames;
-  std::vector<Eigen::Isometry3d> truth;
-  vision::WindowImage image;
-  vision::FrameReport report;
-  std::size_t next = 0;
-};
-
-Iteration track_frame(bool whole_frame) {
-  SimulatedSequence sim = simulate_builtin("mockup_walk", 24);
-  auto s = std::make_shared<TrackFrame>();
-  s->seq = std::move(sim.seq);
-  s->frames = std::move(sim.frames);
-  for (std::size_t i = 0; i < s->frames.size(); ++i) s->truth.push_back(s->seq->ground_truth()[i].cam_T_obj);
-  s->tracker = std::make_unique<vision::ModelTracker>(s->seq->model(), s->seq->camera());
-  return [s, whole_frame] {
+  return [s, start] {
     const std::size_t i = s->next;
     s->next = (i + 1) % s->frames.size();
-    if (auto ok = s->image.assign(s->frames[i]); !ok) throw std::runtime_error(ok.error());
-    if (whole_frame) s->image.prepare_all();
-    s->tracker->track(s->image, s->truth[i == 0 ? 0 : i - 1], s->report);
+    vision::WindowImage* image = &s->image;
+    if (start == Start::ConvertedImage) {
+      image = &s->images[i];
+    } else {
+      if (auto ok = s->image.assign(s->frames[i]); !ok) throw std::runtime_error(ok.error());
+      if (start == Start::FrameWhole) s->image.prepare_all();
+    }
+    s->tracker->track(*image, s->truth[i == 0 ? 0 : i - 1], s->report);
   };
 }
 
-const Registration frame_on_demand{"track_frame", [] { return track_frame(false); }};
-const Registration frame_whole{"track_frame_whole", [] { return track_frame(true); }};
+const Registration track_cycle{"track_cycle", [] { return track_bench(Start::ConvertedImage); }};
+const Registration frame_on_demand{"track_frame", [] { return track_bench(Start::FrameOnDemand); }};
+const Registration frame_whole{"track_frame_whole", [] { return track_bench(Start::FrameWhole); }};
 
 }  // namespace
 }  // namespace epichead::bench
