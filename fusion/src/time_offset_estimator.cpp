@@ -15,12 +15,17 @@ void drop_front(std::vector<T>& v, std::size_t n) {
   v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(n, v.size())));
 }
 
+// Poses kept for pairing: a span and a gap's worth at up to 400 poses a second.
+constexpr std::size_t kRecentCapacity = 96;
+
 }  // namespace
 
 std::expected<TimeOffsetEstimator, std::string> TimeOffsetEstimator::create(const TimeOffsetOptions& o) {
   const double values[] = {o.max_offset_s, o.step_s, o.window_s, o.imu_rate_hz, o.max_pair_gap_s, o.min_rate_rms_radps};
   for (double v : values)
     if (!std::isfinite(v) || !(v > 0)) return std::unexpected("time offset estimator: ranges, step, window and rates must be positive");
+  if (!std::isfinite(o.pair_span_s) || o.pair_span_s < 0 || o.pair_span_s > o.window_s)
+    return std::unexpected("time offset estimator: pair_span_s must be within [0, window_s]");
   if (o.step_s > o.max_offset_s) return std::unexpected("time offset estimator: step_s larger than max_offset_s");
   if (!(o.outlier_factor > 1) || !std::isfinite(o.outlier_factor))
     return std::unexpected("time offset estimator: outlier_factor must be finite and above 1");
@@ -37,6 +42,7 @@ TimeOffsetEstimator::TimeOffsetEstimator(const TimeOffsetOptions& o) : options_(
   costs_.reserve(static_cast<std::size_t>(2 * std::floor(o.max_offset_s / o.step_s) + 1));
   use_.reserve(pairs_.capacity());
   residuals_.reserve(pairs_.capacity());
+  recent_.reserve(kRecentCapacity);
 }
 
 void TimeOffsetEstimator::add_gyro(double t_imu_s, const Eigen::Vector3d& gyro_radps) {
@@ -57,21 +63,29 @@ void TimeOffsetEstimator::add_gyro(double t_imu_s, const Eigen::Vector3d& gyro_r
 
 void TimeOffsetEstimator::add_pose(double t_cam_s, const Eigen::Isometry3d& cam_T_obj) {
   if (!std::isfinite(t_cam_s) || !cam_T_obj.matrix().allFinite()) return;
-  if (have_pose_ && !(t_cam_s > last_pose_t_s_)) return;
+  if (!recent_.empty() && !(t_cam_s > recent_.back().t_s)) return;
   const Eigen::Matrix3d R = cam_T_obj.linear();
-  if (have_pose_ && t_cam_s - last_pose_t_s_ <= options_.max_pair_gap_s) {
+  if (!recent_.empty() && t_cam_s - recent_.back().t_s > options_.max_pair_gap_s) recent_.clear();  // the chain broke
+  // The newest earlier pose at least pair_span_s before this one.
+  for (auto it = recent_.rbegin(); it != recent_.rend(); ++it) {
+    if (t_cam_s - it->t_s < options_.pair_span_s) continue;
     // cam_a_R_cam_b = R_a R_b^T = exp(w dt), w in camera axes.
-    const Eigen::Vector3d w = geometry::so3_log(last_R_ * R.transpose()) / (t_cam_s - last_pose_t_s_);
+    const Eigen::Vector3d w = geometry::so3_log(it->R * R.transpose()) / (t_cam_s - it->t_s);
     if (pairs_.size() == pairs_.capacity()) drop_front(pairs_, pairs_.size() / 2);
-    pairs_.push_back({last_pose_t_s_, t_cam_s, w});
+    pairs_.push_back({it->t_s, t_cam_s, w});
+    break;
   }
+  // Only poses that a later one may still pair with are kept.
+  std::size_t stale = 0;
+  while (stale < recent_.size() && recent_[stale].t_s < t_cam_s - options_.pair_span_s - options_.max_pair_gap_s) ++stale;
+  // More poses than kRecentCapacity within a span and a gap (over 400 a second): the oldest go.
+  if (recent_.size() - stale >= kRecentCapacity) stale = recent_.size() - kRecentCapacity + 1;
+  drop_front(recent_, stale);
+  recent_.push_back({t_cam_s, R});
   // Pairs older than the window are not used.
   std::size_t old = 0;
   while (old < pairs_.size() && pairs_[old].t1_s < t_cam_s - options_.window_s) ++old;
   if (old > 0) drop_front(pairs_, old);
-  have_pose_ = true;
-  last_pose_t_s_ = t_cam_s;
-  last_R_ = R;
 }
 
 bool TimeOffsetEstimator::mean_rate(double a, double b, Eigen::Vector3d& out) const {

@@ -74,6 +74,31 @@ TEST_CASE("time offset: recovered within a millisecond from turning bursts, gyro
   }
 }
 
+TEST_CASE("time offset: pairs 0.1 s apart see through pose jitter that consecutive pairs drown in", "[fusion][time_offset]") {
+  // 0.4 deg of jitter per pose: between consecutive frames (33 ms) that is a rate error of about
+  // 0.3 rad/s per axis, as large as the turn the offset shifts; over 0.1 s a third of it.
+  Feed f;
+  f.pose_noise_rad = 0.007;
+  TimeOffsetOptions consecutive;
+  consecutive.pair_span_s = 0;
+  auto e0 = TimeOffsetEstimator::create(consecutive);
+  auto e1 = TimeOffsetEstimator::create();
+  REQUIRE(e0);
+  REQUIRE(e1);
+  feed(*e0, f);
+  feed(*e1, f);
+  const auto fit0 = e0->fit(), fit1 = e1->fit();
+  REQUIRE(fit0);
+  REQUIRE(fit1);
+  INFO("consecutive: " << fit0->offset_s << " explained " << fit0->explained << "; 0.1 s: " << fit1->offset_s << " explained "
+                       << fit1->explained);
+  CHECK(fit1->explained > fit0->explained + 0.2);
+  CHECK_FALSE(e0->estimate());  // below the 0.6 bar
+  const auto est = e1->estimate();
+  REQUIRE(est);
+  CHECK(est->offset_s == Approx(f.offset_s).margin(0.003));  // 2.4 ms off at this jitter
+}
+
 TEST_CASE("time offset: a few poses tracked 5 deg off are left out, not averaged in", "[fusion][time_offset]") {
   // One wrong pose makes two pairs with rate errors near 2.7 rad/s, far above the bursts' own
   // rates: in a plain squared sum they dominate (explained variation falls below the 0.6 bar,
@@ -149,6 +174,11 @@ TEST_CASE("time offset: bad options and bad samples are refused", "[fusion][time
   CHECK_FALSE(TimeOffsetEstimator::create(o));
   o = {};
   o.outlier_factor = 1.0;
+  CHECK_FALSE(TimeOffsetEstimator::create(o));
+  o = {};
+  o.pair_span_s = -0.1;
+  CHECK_FALSE(TimeOffsetEstimator::create(o));
+  o.pair_span_s = NAN;
   CHECK_FALSE(TimeOffsetEstimator::create(o));
   auto e = TimeOffsetEstimator::create();
   REQUIRE(e);

@@ -30,7 +30,12 @@ struct TimeOffsetOptions {
   double step_s = 0.0005;           // grid step before the parabolic refinement
   double window_s = 4.0;            // pose pairs from this far back are used
   double imu_rate_hz = 1000;        // sizes the gyro store
-  double max_pair_gap_s = 0.1;      // poses further apart than this are not paired
+  double max_pair_gap_s = 0.1;      // consecutive poses further apart than this break the chain
+  // A pose is paired with the newest earlier pose at least this long before it (3 frames at
+  // 30 Hz), along an unbroken chain. Between consecutive frames the turn is small against the
+  // poses' own jitter, and the fit explained little: over 0.1 s the turn is several times larger
+  // and the jitter the same (docs/fusion.md, "Pairs 0.1 s apart"). 0: the previous pose.
+  double pair_span_s = 0.09;
   int min_pairs = 45;             // 1.5 s of poses at 30 Hz
   double min_rate_rms_radps = 0.15;  // the camera must turn at least this much (RMS) to tell
   double min_explained = 0.6;       // fraction of the rate variation the fit must explain
@@ -84,9 +89,13 @@ class TimeOffsetEstimator {
   mutable std::vector<double> costs_;  // fit()'s grid, sized at create()
   mutable std::vector<unsigned char> use_;  // fit()'s per-pair flag (usable, not an outlier)
   mutable std::vector<double> residuals_;   // fit()'s scratch for the median, sized at create()
-  bool have_pose_ = false;
-  double last_pose_t_s_ = 0;
-  Eigen::Matrix3d last_R_ = Eigen::Matrix3d::Identity();
+  // The recent poses of the current chain (camera clock, cam_R_obj), oldest first: the pairs'
+  // earlier ends.
+  struct Recent {
+    double t_s;
+    Eigen::Matrix3d R;
+  };
+  std::vector<Recent> recent_;
   Eigen::Vector3d last_gyro_ = Eigen::Vector3d::Zero();
 };
 
