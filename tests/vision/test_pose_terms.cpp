@@ -16,6 +16,11 @@ using namespace epichead::vision::detail;
 
 namespace {
 
+// The definition of a line's residual: the edgel's signed distance from the line's image.
+double line_residual(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d& xn, double focal) {
+  return focal * img.l.dot(Eigen::Vector3d(xn.x(), xn.y(), 1)) / img.s / obs.sigma_px;
+}
+
 // The definition: per edgel, the residual, Tukey's weight and cost and dr/dl, summed as they come.
 void reference_line_block(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
                           const Tukey& k, NormalEquations& ne, Eigen::Matrix3d& M, Eigen::Vector3d& v) {

@@ -13,8 +13,9 @@ namespace {
 // Tukey's cut and selects, which it must to vectorise: a floating-point exception flag is the
 // only thing that can differ, and nothing reads them.
 //
-// xy: n (x, y) pairs. Each value is the expression of line_residual, Tukey and add_line_block's
-// dr/dl, written out term by term in the order Eigen evaluates them: l . (x, y, 1) is
+// xy: n (x, y) pairs. Each value is the one-loop definition's Eigen expression (the residual,
+// Tukey, dr/dl; tests/vision/test_pose_terms.cpp), written out term by term in the order Eigen
+// evaluates them: l . (x, y, 1) is
 // (lx x + ly y) + lz, and dr/dl = (x / s - ldx / (s s s) (lx, ly, 0)) focal / sigma.
 EPICHEAD_AVX2_CLONE void edgel_values(const double* __restrict xy, int n, double lx, double ly, double lz, double s,
                                       double focal, double sigma, bool with_cost, bool with_derivatives, double c,

@@ -10,13 +10,9 @@ namespace epichead::vision::detail {
 
 void add_line_cost(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
                    const Tukey& k, double& sum) {
-  EdgelChunk chunk;
-  const int total = static_cast<int>(obs.edgels_px.size());
-  for (int first = 0; first < total; first += kEdgelChunk) {
-    const int n = std::min(kEdgelChunk, total - first);
-    line_edgel_values(obs, img, xns + first, n, focal, &k, false, chunk);
-    for (int q = 0; q < n; ++q) sum += chunk.rho[q];
-  }
+  for_each_edgel_chunk(obs, img, xns, focal, &k, false, [&](const EdgelChunk& c, int, int n) {
+    for (int q = 0; q < n; ++q) sum += c.rho[q];
+  });
 }
 
 // A line's residuals depend on the pose only through its image line l, so r_k = f(l, x_k) and
@@ -37,11 +33,7 @@ void add_line_block(const LineObservation& obs, const LineImage& img, const Eige
   Eigen::Vector3d s0 = Eigen::Vector3d::Zero(), s1 = Eigen::Vector3d::Zero();
   double w0 = 0, wt = 0, t_min = 0, t_max = 0;
   const Eigen::Vector2d along(-l.y() / s, l.x() / s);
-  EdgelChunk chunk;
-  const int total = static_cast<int>(obs.edgels_px.size());
-  for (int first = 0; first < total; first += kEdgelChunk) {
-    const int n = std::min(kEdgelChunk, total - first);
-    line_edgel_values(obs, img, xns + first, n, focal, &k, true, chunk);
+  for_each_edgel_chunk(obs, img, xns, focal, &k, true, [&](const EdgelChunk& chunk, int first, int n) {
     for (int q = 0; q < n; ++q) {
       const double r = chunk.r[q], w = chunk.w[q];
       const double d[3] = {chunk.d0[q], chunk.d1[q], chunk.d2[q]};
@@ -66,7 +58,7 @@ void add_line_block(const LineObservation& obs, const LineImage& img, const Eige
         t_max = first + q ? std::max(t_max, t) : t;
       }
     }
-  }
+  });
   const Eigen::Map<const Eigen::Matrix3d> M(m);
   const Eigen::Vector3d v(v0, v1, v2);
   // dl/dxi of l = A x B under a left perturbation of the pose: dA = [I | -[A]x] dxi (same for

@@ -85,16 +85,12 @@ inline LineImage line_image(const LineObservation& obs, const Eigen::Isometry3d&
   return img;
 }
 
-// The residual of an undistorted edgel xn from the line's image.
-inline double line_residual(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d& xn, double focal) {
-  return focal * img.l.dot(Eigen::Vector3d(xn.x(), xn.y(), 1)) / img.s / obs.sigma_px;
-}
-
 // A line's edgels are taken kEdgelChunk at a time: first each edgel's own values (residual,
 // Tukey weight and cost, dr/dl), element-wise with no sums, so that the loop vectorises; then the
-// sums, in edgel order. The values are line_residual's and add_line_block's expressions term by
-// term, so the totals are those of one loop doing both (tests/vision/test_pose_estimator.cpp
-// holds them to that, bit for bit).
+// sums, in edgel order. The residual is the signed distance r = focal l . (x, y, 1) / |l_xy| /
+// sigma_px; the values are written term by term as the one-loop Eigen expressions evaluated
+// them, so the totals are those of one loop doing both (tests/vision/test_pose_terms.cpp holds
+// them to that definition, bit for bit).
 inline constexpr int kEdgelChunk = 64;
 
 struct EdgelChunk {
@@ -109,16 +105,26 @@ struct EdgelChunk {
 void line_edgel_values(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, int n, double focal,
                        const Tukey* k, bool with_derivatives, EdgelChunk& out);
 
-// fn(r) for each of the line's edgels (xns: its undistorted edgels).
+// fn(chunk, first, n) for each chunk of the line's edgels (xns: its undistorted edgels), in
+// order: the chunk holds the values of edgels [first, first + n) as line_edgel_values gives them.
 template <class Fn>
-void line_residuals(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal, Fn&& fn) {
+void for_each_edgel_chunk(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal,
+                          const Tukey* k, bool with_derivatives, Fn&& fn) {
   EdgelChunk chunk;
   const int total = static_cast<int>(obs.edgels_px.size());
   for (int first = 0; first < total; first += kEdgelChunk) {
     const int n = std::min(kEdgelChunk, total - first);
-    line_edgel_values(obs, img, xns + first, n, focal, nullptr, false, chunk);
-    for (int q = 0; q < n; ++q) fn(chunk.r[q]);
+    line_edgel_values(obs, img, xns + first, n, focal, k, with_derivatives, chunk);
+    fn(static_cast<const EdgelChunk&>(chunk), first, n);
   }
+}
+
+// fn(r) for each of the line's edgels, in order.
+template <class Fn>
+void line_residuals(const LineObservation& obs, const LineImage& img, const Eigen::Vector2d* xns, double focal, Fn&& fn) {
+  for_each_edgel_chunk(obs, img, xns, focal, nullptr, false, [&](const EdgelChunk& c, int, int n) {
+    for (int q = 0; q < n; ++q) fn(c.r[q]);
+  });
 }
 
 // Tukey's cost summed over the line's edgels onto sum, in edgel order.
