@@ -3,14 +3,17 @@
 # boots Debian's own kernel, because the build machine's kernel has no vcan, uhid, gpio-sim or
 # vivid. See docs/vm.md.
 #
-#   tests/vm/run_vm_test.sh --bin-dir BUILD/bin [--phases "devices onboard"] [--timeout S] [--keep]
+#   tests/vm/run_vm_test.sh --bin-dir BUILD/bin [--phases "devices onboard"] [--timeout S]
+#                           [--work-dir DIR] [--keep]
 #
 # Steps: fetch Debian's kernel package into a cache (apt-get download + dpkg-deb -x, no system
-# install), pack an uncompressed initramfs (busybox, the modules with their dependencies,
-# tests/vm/init.sh as /init, the test binaries and the shared libraries ldd names), boot it with
-# qemu-system-x86_64 (KVM when it works, else TCG), read the serial console and exit with the
-# VM's status. Exit 77 (ctest's SKIP_RETURN_CODE) when qemu, busybox, cpio or the kernel is
-# missing; 1 when a test failed; 2 on bad usage; 124 when the VM ran out of time.
+# install), pack a gzip-compressed initramfs (busybox, the modules with their dependencies,
+# tests/vm/init.sh as /init, the test binaries, and -- read straight from the host into a second
+# part -- the shared libraries ldd names), boot it with qemu-system-x86_64 (KVM when it works, else
+# TCG), read the serial console and exit with the VM's status. The work files go to a new folder
+# in --work-dir (default $TMPDIR or /tmp) and are removed afterwards. Exit 77 (ctest's
+# SKIP_RETURN_CODE) when qemu, busybox, cpio, gzip or the kernel is missing; 1 when a test
+# failed or the work folder's disk is too full; 2 on bad usage; 124 when the VM ran out of time.
 #
 # Environment: EPICHEAD_VM_CACHE (kernel cache, default ~/.cache/epichead/vm),
 # EPICHEAD_VM_ACCEL (auto | kvm | tcg), EPICHEAD_VM_KERNEL_PKG (default: what
@@ -24,6 +27,7 @@ bin_dir=""
 phases="devices onboard"
 timeout_s=240
 keep=0
+work_parent="${TMPDIR:-/tmp}"
 skip() { echo "vm-test: SKIP: $*" >&2; exit 77; }
 die() { echo "vm-test: $*" >&2; exit 2; }
 log() { echo "vm-test: $*" >&2; }
@@ -33,8 +37,9 @@ while (($#)); do
     --bin-dir) bin_dir="${2:?}"; shift 2 ;;
     --phases) phases="${2:?}"; shift 2 ;;
     --timeout) timeout_s="${2:?}"; shift 2 ;;
+    --work-dir) work_parent="${2:?}"; shift 2 ;;
     --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) die "unknown argument '$1' (see --help)" ;;
   esac
 done
@@ -54,11 +59,12 @@ qemu="$(command -v qemu-system-x86_64 || true)"
 [[ -n "$qemu" ]] || skip "qemu-system-x86_64 not installed (Debian package qemu-system-x86)"
 busybox=/bin/busybox
 [[ -x "$busybox" ]] && ! ldd "$busybox" >/dev/null 2>&1 || skip "no static /bin/busybox (Debian package busybox-static)"
-for tool in cpio dpkg-deb objcopy ldd timeout; do
+for tool in cpio gzip dpkg-deb objcopy ldd timeout; do
   command -v "$tool" >/dev/null || skip "$tool not installed"
 done
 
-work="$(mktemp -d "${TMPDIR:-/tmp}/epichead-vm.XXXXXX")"
+mkdir -p "$work_parent" || die "--work-dir $work_parent: cannot create it"
+work="$(mktemp -d "$work_parent/epichead-vm.XXXXXX")"
 cleanup() {
   if ((keep)); then log "kept $work"; else rm -rf "$work"; fi
 }
@@ -149,15 +155,21 @@ fi
 cp "$kroot/lib/modules/$kversion"/modules.{order,builtin,builtin.modinfo} "$root/lib/modules/$kversion/"
 "$busybox" depmod -b "$root" "$kversion"
 
-# Binaries without debug sections (smaller cpio, faster unpacking) and the libraries they load.
+# Binaries without debug sections (smaller cpio, faster unpacking). The libraries they load are
+# not copied: OpenCV's video and image codecs alone pull in some 300 MB of libraries, and a copy
+# plus the archive made of it once filled a CI machine's /tmp. They are listed here, each under
+# its folder's real path (/lib is a link to usr/lib on merged /usr, made in the root above), and
+# read straight from the host into the archive's second part below.
+declare -A libs=()
 add_binary() {
   local src="$1" dest="$root/opt/epichead/bin/$(basename "$1")"
   objcopy --strip-debug "$src" "$dest"
-  ldd "$src" | awk '/=> \//{print $3} /^\t\/[^ ]+ \(/{print $1}' | while read -r lib; do
-    [[ -e "$root$lib" ]] && continue
-    mkdir -p "$(dirname "$root$lib")"
-    cp -L "$lib" "$root$lib"
-  done
+  local lib dir
+  while read -r lib; do
+    dir="$(realpath "$(dirname "$lib")")"
+    libs["${dir#/}/$(basename "$lib")"]=1
+    mkdir -p "$root$dir"
+  done < <(ldd "$src" | awk '/=> \//{print $3} /^\t\/[^ ]+ \(/{print $1}')
 }
 add_binary "$bin_dir/epichead_test_hw_devices"
 if [[ " $phases " == *" onboard "* ]]; then
@@ -177,8 +189,22 @@ PHASES="$phases"
 REQUIRE_DEVICES="$require_devices"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 EOF
-(cd "$root" && find . | cpio -o -H newc --quiet) >"$work/initrd.cpio"
-log "initramfs $(du -m "$work/initrd.cpio" | cut -f1) MB, kernel $kversion, modules: ${modules_loaded[*]}"
+# Two gzip-compressed archives one after the other, as the kernel accepts them: the root with the
+# folders, then the libraries read from the host (-L: a library's content, not the link ldd
+# found). Compressed, they are half the size; unpacking them costs the VM no measurable time.
+lib_mb="$(cd / && printf '%s\n' "${!libs[@]}" | xargs du -cmL | tail -1 | cut -f1)"
+root_mb="$(du -sm "$root" | cut -f1)"
+need_mb=$(((lib_mb + root_mb) / 2 + 50))
+free_mb="$(df -Pm "$work" | awk 'NR==2{print $4}')"
+if ((free_mb < need_mb)); then
+  log "FAILED: $work has ${free_mb} MB free; the initramfs needs about ${need_mb} MB" \
+      "(${root_mb} MB of binaries and modules and ${lib_mb} MB of libraries, compressed). Free some space or pass --work-dir."
+  exit 1
+fi
+(cd "$root" && find . | cpio -o -H newc --quiet | gzip -1) >"$work/initrd.cpio"
+(cd / && printf '%s\n' "${!libs[@]}" | sort | cpio -o -H newc -L --quiet | gzip -1) >>"$work/initrd.cpio"
+log "initramfs $(du -m "$work/initrd.cpio" | cut -f1) MB (${root_mb} MB of binaries and modules and ${lib_mb} MB of" \
+    "${#libs[@]} libraries before compression), kernel $kversion, modules: ${modules_loaded[*]}"
 
 # --- boot ------------------------------------------------------------------------------------
 # KVM when /dev/kvm is usable and a probe boot works (nested KVM often is not), else TCG.
