@@ -264,14 +264,12 @@ void say_time_offset(const nlohmann::json& predictor) {
                 1e3 * e.value("offset_s", 0.0), e.value("adopted_at_s", 0.0), 100 * e.value("explained", 0.0));
     return;
   }
-  char why[160] = "too few tracked frames";
-  if (e.contains("explained"))
-    std::snprintf(why, sizeof why, "the last fit explained %.0f %% of the camera's turn, 60 %% needed; turn rate %.2f rad/s RMS",
-                  100 * e.value("explained", 0.0), e.value("rate_rms_radps", 0.0));
+  std::string why = e.value("shortfall", std::string("too few tracked frames"));
+  if (why.empty()) why = "the fit met its bars only after the last try";  // tries are a few frames apart
   std::fprintf(stderr,
                "track: the camera-IMU time offset could not be estimated (%s): the IMU was used as if on the camera's "
                "clock, give --imu-time-offset-s if the offset is known\n",
-               why);
+               why.c_str());
 }
 
 // Detection for the start in one frame: the predictor made from the found pose (the sequence's

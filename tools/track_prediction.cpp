@@ -239,9 +239,11 @@ class ImuPredictor final : public TrackPredictor {
     nlohmann::json estimated = nullptr;
     if (estimator_) {
       estimated = {{"adopted", adopted_}, {"adopted_at_s", adopted_ ? adopted_at_s_ : -1.0}};
-      if (const auto e = adopted_ ? std::optional(adopted_fit_) : estimator_->fit())
+      if (const auto e = adopted_ ? std::optional(adopted_fit_) : estimator_->fit()) {
         estimated.update({{"offset_s", e->offset_s}, {"explained", e->explained}, {"pairs", e->pairs},
                           {"rate_rms_radps", e->rate_rms_radps}, {"outlier_pairs", e->outlier_pairs}});
+        if (!adopted_) estimated["shortfall"] = estimator_->shortfall(*e);
+      }
     }
     return {{"model", "imu"},
             {"imu_time_offset_s", offset_s_},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "epichead/geometry/so3.h"
 
@@ -190,10 +191,37 @@ std::optional<TimeOffsetEstimate> TimeOffsetEstimator::fit() const {
 
 std::optional<TimeOffsetEstimate> TimeOffsetEstimator::estimate() const {
   auto e = fit();
-  if (!e || e->pairs < options_.min_pairs || e->rate_rms_radps < options_.min_rate_rms_radps ||
-      e->explained < options_.min_explained || e->at_search_edge)
-    return std::nullopt;
+  if (!e || !shortfall(*e).empty()) return std::nullopt;
   return e;
+}
+
+std::string TimeOffsetEstimator::shortfall(const TimeOffsetEstimate& e) const {
+  std::string out;
+  char part[96];
+  const auto add = [&] {
+    if (!out.empty()) out += "; ";
+    out += part;
+  };
+  if (e.pairs < options_.min_pairs) {
+    std::snprintf(part, sizeof part, "%d pose pairs, %d needed", e.pairs, options_.min_pairs);
+    add();
+  }
+  if (e.rate_rms_radps < options_.min_rate_rms_radps) {
+    std::snprintf(part, sizeof part, "the camera turned %.2f rad/s RMS, %.2f needed", e.rate_rms_radps,
+                  options_.min_rate_rms_radps);
+    add();
+  }
+  if (e.explained < options_.min_explained) {
+    std::snprintf(part, sizeof part, "the fit explained %.0f %% of the turn, %.0f %% needed", 100 * e.explained,
+                  100 * options_.min_explained);
+    add();
+  }
+  if (e.at_search_edge) {
+    std::snprintf(part, sizeof part, "the best offset lay at the search range's edge (+-%.0f ms)",
+                  1e3 * options_.max_offset_s);
+    add();
+  }
+  return out;
 }
 
 }  // namespace epichead::fusion

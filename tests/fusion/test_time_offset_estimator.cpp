@@ -93,9 +93,12 @@ TEST_CASE("time offset: pairs 0.1 s apart see through pose jitter that consecuti
   INFO("consecutive: " << fit0->offset_s << " explained " << fit0->explained << "; 0.1 s: " << fit1->offset_s << " explained "
                        << fit1->explained);
   CHECK(fit1->explained > fit0->explained + 0.2);
-  CHECK_FALSE(e0->estimate());  // below the 0.6 bar
+  CHECK_FALSE(e0->estimate());  // below the 0.6 bar, and it says so
+  CHECK(e0->shortfall(*fit0).find("the fit explained") != std::string::npos);
+  CHECK(e0->shortfall(*fit0).find("60 % needed") != std::string::npos);
   const auto est = e1->estimate();
   REQUIRE(est);
+  CHECK(e1->shortfall(*est).empty());
   CHECK(est->offset_s == Approx(f.offset_s).margin(0.003));  // 2.4 ms off at this jitter
 }
 
@@ -147,6 +150,9 @@ TEST_CASE("time offset: no estimate while the camera is still, or from too few p
   for (int i = 0; i < 4000; ++i) e->add_gyro(i * 1e-3, Eigen::Vector3d::Zero());
   for (int k = 0; k < 100; ++k) e->add_pose(0.2 + k / 30.0, pose);
   CHECK_FALSE(e->estimate());
+  const auto still = e->fit();
+  REQUIRE(still);
+  CHECK(e->shortfall(*still).find("the camera turned 0.00 rad/s RMS, 0.15 needed") != std::string::npos);
   // Moving but for half a second only (15 poses).
   auto short_run = TimeOffsetEstimator::create();
   REQUIRE(short_run);
@@ -154,6 +160,7 @@ TEST_CASE("time offset: no estimate while the camera is still, or from too few p
   f.seconds = 0.5;
   feed(*short_run, f);
   CHECK_FALSE(short_run->estimate());
+  if (const auto brief = short_run->fit()) CHECK(short_run->shortfall(*brief).find("45 needed") != std::string::npos);
 }
 
 TEST_CASE("time offset: an offset beyond the search range is not reported as one at its edge", "[fusion][time_offset]") {

@@ -68,6 +68,9 @@ class TimeOffsetEstimator {
   // The fit when it passes the options' quality bars (pairs, excitation, explained, not at the
   // edge of the search range).
   std::optional<TimeOffsetEstimate> estimate() const;
+  // The bars a fit misses, each with its value and the bar ("the camera turned 0.05 rad/s RMS,
+  // 0.15 needed"), joined by "; "; empty when it passes them.
+  std::string shortfall(const TimeOffsetEstimate& fit) const;
 
  private:
   explicit TimeOffsetEstimator(const TimeOffsetOptions& options);
