@@ -57,6 +57,7 @@ struct TrackArgs {
   int window_px = WindowOptions{}.width_px;
   double coast_s = 0.2;
   std::string imu_time_offset = "auto";
+  std::optional<double> imu_time_offset_sigma_s;
   std::string free_turn = "auto";
   bool settle = true;
   bool outline_colours = true;
@@ -276,13 +277,13 @@ void say_time_offset(const nlohmann::json& predictor) {
 // init set to it), or nothing when the object was not found.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> start_from_detection(Sequence& seq, TrackAcquisition& acquisition,
                                                                                  const cv::Mat& frame, const FrameEntry& entry,
-                                                                                 bool imu, std::optional<double> offset,
+                                                                                 bool imu, const ImuClock& clock,
                                                                                  const std::optional<Eigen::Vector3d>& up_obj) {
   const auto found = acquisition.find_start(frame, entry.frame, entry.t_s);
   if (!found) return std::unexpected(found.error());
   if (!*found) return std::unique_ptr<TrackPredictor>{};
   seq.set_init({entry.frame, entry.t_s, **found, ""});
-  return make_track_predictor(seq, imu, offset, up_obj);
+  return make_track_predictor(seq, imu, clock, up_obj);
 }
 
 struct TrackCounts {
@@ -338,12 +339,13 @@ int run_track(const TrackArgs& args) {
   if (!seq) return fail(cmd, seq.error());
   const auto offset = imu_time_offset(args.imu_time_offset);
   if (!offset) return fail(cmd, offset.error());
+  const ImuClock clock{*offset, args.imu_time_offset_sigma_s};
   if (args.imu == "on" && !seq->has_imu()) return fail(cmd, "--imu on: " + seq->dir() + " has no imu.csv");
   const auto up = object_up(args.acquisition.detection);
   if (!up) return fail(cmd, up.error());
   // Without init.csv the predictor is made once detection has found the start.
   std::expected<std::unique_ptr<TrackPredictor>, std::string> predictor = std::unique_ptr<TrackPredictor>{};
-  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", *offset, *up);
+  if (seq->has_init()) predictor = make_track_predictor(*seq, args.imu == "on", clock, *up);
   if (!predictor) return fail(cmd, predictor.error());
 
   namespace fs = std::filesystem;
@@ -393,7 +395,7 @@ int run_track(const TrackArgs& args) {
     const FrameEntry& entry = seq->frames()[i];
     if (!*predictor) {
       // No start yet: detect in this frame; frames before the start have no pose.
-      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", *offset, *up);
+      auto started = start_from_detection(*seq, acquisition, *frame, entry, args.imu == "on", clock, *up);
       if (!started) return fail(cmd, started.error());
       if (!*started) {
         ++counts.searched_frames;
@@ -529,6 +531,10 @@ const CommandRegistration registration{
       app.add_option("--imu-time-offset-s", a->imu_time_offset,
                      "How far the IMU clock runs ahead of the camera clock (t_camera = t_imu - offset), s, or 'auto' "
                      "(default: estimated from the gyro and the tracked poses once the camera has turned enough)");
+      app.add_option("--imu-time-offset-sigma-s", a->imu_time_offset_sigma_s,
+                     "How far the offset may be off (1-sigma), s: each pose is trusted the less the faster the camera "
+                     "moves (default: 0 for a given offset; with auto, 0.01 until it is estimated)")
+          ->check(CLI::Range(0.0, 0.1));
       app.add_flag("!--no-video", a->video, "Do not write overlay.mp4");
       app.add_option("--zoom", a->zoom, "PNG overlays show only this region (X,Y,W,H pixels), enlarged twice")
           ->delimiter(',')

@@ -247,6 +247,7 @@ class ImuPredictor final : public TrackPredictor {
     }
     return {{"model", "imu"},
             {"imu_time_offset_s", offset_s_},
+            {"imu_time_offset_sigma_s", adopted_ ? kEstimatedOffsetSigmaS : options_.imu_time_offset_sigma_s},
             {"imu_time_offset_estimate", estimated},
             {"imu_accepted", c.imu_accepted},
             {"imu_rejected", c.imu_non_finite + c.imu_saturated + c.imu_out_of_order + c.imu_duplicate},
@@ -363,10 +364,11 @@ class ImuPredictor final : public TrackPredictor {
 }  // namespace
 
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s,
+                                                                                 const ImuClock& clock,
                                                                                  const std::optional<Eigen::Vector3d>& object_up_obj) {
   if (use_imu) {
     if (!seq.has_imu()) return std::unexpected("--imu on: " + seq.dir() + " has no imu.csv");
+    const std::optional<double>& imu_time_offset_s = clock.offset_s;
     if (imu_time_offset_s && !std::isfinite(*imu_time_offset_s)) return std::unexpected("--imu-time-offset-s must be finite");
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
@@ -376,7 +378,7 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     // a second of gated frames, when the filter is surely lost too.
     options.reinit_after_gated = 15;
     // Until the offset is estimated, every pose's time on the IMU clock is that uncertain.
-    if (!imu_time_offset_s) options.imu_time_offset_sigma_s = kUnknownOffsetSigmaS;
+    options.imu_time_offset_sigma_s = clock.sigma_s.value_or(imu_time_offset_s ? 0.0 : kUnknownOffsetSigmaS);
     // A body of revolution's poses turn freely about its axis: only the axis's tilt is checked.
     if (const auto axis = vision::find_revolution_axis(seq.model())) options.gravity_check.free_turn_axis_obj = axis->direction_obj.normalized();
     if (object_up_obj) options.gravity_check.told_down_obj = -*object_up_obj;

@@ -71,14 +71,22 @@ class TrackPredictor {
   virtual nlohmann::json diagnostics() const = 0;
 };
 
-// --imu on needs the sequence's imu.csv; the error says so when it is missing. The IMU's clock
-// runs imu_time_offset_s ahead of the camera's (t_camera = t_imu - offset). Without a value
-// (auto) the offset starts at 0 and is estimated from the tracked poses and the gyro
-// (fusion/time_offset_estimator.h); once the estimate is confident the filter restarts with it.
+// The camera-IMU clock offset as the user gave it (--imu-time-offset-s, --imu-time-offset-sigma-s).
+struct ImuClock {
+  // How far the IMU's clock runs ahead of the camera's (t_camera = t_imu - offset). Without a
+  // value (auto) it starts at 0 and is estimated from the tracked poses and the gyro
+  // (fusion/time_offset_estimator.h); once the estimate is confident the filter restarts with it.
+  std::optional<double> offset_s;
+  // Its 1-sigma, which each vision pose's covariance carries as the pose's motion over that time.
+  // Without a value: 0 for a given offset, 10 ms while an auto one is not yet estimated.
+  std::optional<double> sigma_s;
+};
+
+// --imu on needs the sequence's imu.csv; the error says so when it is missing.
 // object_up_obj (--object-up, unit): the object's up in its model frame when the user knows it;
 // the gravity check then takes its down from the first frame instead of learning it.
 std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor(const vision::Sequence& seq, bool use_imu,
-                                                                                 std::optional<double> imu_time_offset_s,
+                                                                                 const ImuClock& clock,
                                                                                  const std::optional<Eigen::Vector3d>& object_up_obj);
 
 }  // namespace epichead::tools

@@ -94,6 +94,7 @@ TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the track
   const auto fr = nlohmann::json::parse(slurp(tmp / "fixed/report.json"));
   CHECK(fr["predictor"]["imu_time_offset_s"].get<double>() == 0.01);
   CHECK(fr["predictor"]["imu_time_offset_estimate"].is_null());
+  CHECK(fr["predictor"]["imu_time_offset_sigma_s"].get<double>() == 0);  // a given offset is exact unless told otherwise
   CHECK(fixed.out.find("time offset") == std::string::npos);
   CHECK(fixed.err.find("time offset") == std::string::npos);
   // Too short a run to estimate it: said on stderr, with the way out.
@@ -101,6 +102,15 @@ TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the track
   REQUIRE(brief.exit_code == 0);
   CHECK(brief.err.find("time offset could not be estimated") != std::string::npos);
   CHECK(brief.err.find("needed") != std::string::npos);  // which bar it missed
+  CHECK(nlohmann::json::parse(slurp(tmp / "brief/report.json"))["predictor"]["imu_time_offset_sigma_s"].get<double>() == 0.01);
+  // A given offset known to a few milliseconds: the poses carry that doubt.
+  const auto loose = run_epichead(tmp, "track " + q(seq) + " --out " + q(tmp / "loose") +
+                                           " --imu on --imu-time-offset-s 0.01 --imu-time-offset-sigma-s 0.004 --frames 20 --every 0 --no-video");
+  REQUIRE(loose.exit_code == 0);
+  CHECK(nlohmann::json::parse(slurp(tmp / "loose/report.json"))["predictor"]["imu_time_offset_sigma_s"].get<double>() == 0.004);
+  const auto wide = run_epichead(tmp, "track " + q(seq) + " --out " + q(tmp / "wide") + " --imu on --imu-time-offset-sigma-s 0.5 --every 0 --no-video");
+  CHECK(wide.exit_code != 0);
+  CHECK(wide.err.find("--imu-time-offset-sigma-s") != std::string::npos);
   CHECK(brief.err.find("--imu-time-offset-s") != std::string::npos);
 }
 

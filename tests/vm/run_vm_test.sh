@@ -192,7 +192,7 @@ EOF
 # Two gzip-compressed archives one after the other, as the kernel accepts them: the root with the
 # folders, then the libraries read from the host (-L: a library's content, not the link ldd
 # found). Compressed, they are half the size; unpacking them costs the VM no measurable time.
-lib_mb="$(cd / && printf '%s\n' "${!libs[@]}" | xargs du -cmL | tail -1 | cut -f1)"
+lib_mb="$(cd / && printf '%s\n' "${!libs[@]}" | xargs du -bL | awk '{s += $1} END {print int(s / 1048576)}')"
 root_mb="$(du -sm "$root" | cut -f1)"
 need_mb=$(((lib_mb + root_mb) / 2 + 50))
 free_mb="$(df -Pm "$work" | awk 'NR==2{print $4}')"
