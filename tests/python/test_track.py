@@ -110,3 +110,26 @@ def test_imu_predictor_propagates_a_turn():
     angle = np.arccos(np.clip((np.trace(pred.pose[:3, :3]) - 1) / 2, -1, 1))
     assert angle == pytest.approx(0.1, abs=0.01)
     assert p.status(0.299)["counters"]["imu_accepted"] >= 100
+
+
+def test_an_uncertain_clock_offset_weighs_a_pose_taken_mid_turn_less():
+    # The same late pose (where the camera was 10 ms earlier, turning at 1 rad/s) is further from
+    # the prediction, in Mahalanobis terms, when the offset is told exact than when it may be
+    # 10 ms off.
+    def run(sigma_s):
+        p = epichead.Predictor(mode="imu", imu_time_offset_sigma_s=sigma_s)
+        g = np.array([0.0, -9.81, 0.0])
+        for k in range(200):
+            p.add_imu(k * 0.001, np.zeros(3), g)
+        pose = np.eye(4)
+        pose[2, 3] = 1.0
+        assert p.add_vision(0.199, pose, np.eye(6) * 1e-6)[0] == "initialised"
+        for k in range(200, 320):
+            p.add_imu(k * 0.001, np.array([0.0, 1.0, 0.0]), g)
+        late = p.predict(0.289).pose
+        verdict, d2 = p.add_vision(0.299, late, np.eye(6) * 1e-6)
+        return d2
+
+    assert run(0.01) < 0.5 * run(0.0)
+    with pytest.raises(epichead.Error, match="imu_time_offset_sigma_s"):
+        epichead.Predictor(imu_time_offset_sigma_s=-1.0)

@@ -53,18 +53,21 @@ void bind_fusion(py::module_& m) {
                         "The Kalman predictor: IMU samples (mode 'imu') or the vision poses alone ('constant_velocity'), "
                         "late vision poses applied at their exposure time, the pose predicted at any time")
       .def(py::init([](const std::string& mode, double imu_time_offset_s, double imu_rate_hz, double buffer_s,
-                       const std::optional<Eigen::Matrix3d>& cam_R_imu) {
+                       const std::optional<Eigen::Matrix3d>& cam_R_imu, double imu_time_offset_sigma_s) {
              PredictorOptions o;
              o.mode = parse_mode(mode);
              o.imu_time_offset_s = imu_time_offset_s;
+             o.imu_time_offset_sigma_s = imu_time_offset_sigma_s;
              o.imu_rate_hz = imu_rate_hz;
              o.buffer_s = buffer_s;
              if (cam_R_imu) o.mount.cam_R_imu = *cam_R_imu;
              return value_or_raise(Predictor::create(o));
            }),
            py::arg("mode") = "imu", py::arg("imu_time_offset_s") = 0.0, py::arg("imu_rate_hz") = 1000.0,
-           py::arg("buffer_s") = 0.5, py::arg("cam_R_imu") = py::none(),
-           "imu_time_offset_s: how far the IMU clock runs ahead of the camera's (t_camera = t_imu - offset)")
+           py::arg("buffer_s") = 0.5, py::arg("cam_R_imu") = py::none(), py::arg("imu_time_offset_sigma_s") = 0.0,
+           "imu_time_offset_s: how far the IMU clock runs ahead of the camera's (t_camera = t_imu - offset); "
+           "imu_time_offset_sigma_s: how far that may be off (1-sigma, s), carried by each pose's covariance as "
+           "its motion over that time")
       .def(
           "add_imu",
           [](Predictor& p, double t_s, const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel) {
