@@ -247,7 +247,7 @@ class ImuPredictor final : public TrackPredictor {
     }
     return {{"model", "imu"},
             {"imu_time_offset_s", offset_s_},
-            {"imu_time_offset_sigma_s", adopted_ ? kEstimatedOffsetSigmaS : options_.imu_time_offset_sigma_s},
+            {"imu_time_offset_sigma_s", predictor_.options().imu_time_offset_sigma_s},  // adopt() changes it
             {"imu_time_offset_estimate", estimated},
             {"imu_accepted", c.imu_accepted},
             {"imu_rejected", c.imu_non_finite + c.imu_saturated + c.imu_out_of_order + c.imu_duplicate},
