@@ -1,11 +1,12 @@
-# epichead_module(NAME <lib> DEPS <targets...>): one static library per top-level folder,
-# sources from src/, public headers from include/. A module without sources yet is an
+# epichead_module(NAME <lib> DEPS <targets...> [PCH <parts...>]): one static library per
+# top-level folder, sources from src/, public headers from include/; PCH names the libraries
+# whose headers its precompiled header holds (epichead_precompile, PrecompiledHeaders.cmake). A module without sources yet is an
 # interface target, so the dependency graph stays the same while it is being written.
 # Every module is also epichead::<name without the prefix> (the name an installed package's
 # users link, docs/install.md) and is installed with its headers.
 include(GNUInstallDirs)
 function(epichead_module)
-  cmake_parse_arguments(M "" "NAME" "DEPS" ${ARGN})
+  cmake_parse_arguments(M "" "NAME" "DEPS;PCH" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp)
   set(include_dirs $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(NOT sources)
@@ -16,6 +17,9 @@ function(epichead_module)
     add_library(${M_NAME} STATIC ${sources})
     target_include_directories(${M_NAME} PUBLIC ${include_dirs} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
     target_link_libraries(${M_NAME} PUBLIC ${M_DEPS})
+    if(DEFINED M_PCH)
+      epichead_precompile(${M_NAME} ${M_PCH})
+    endif()
   endif()
   epichead_install_library(${M_NAME} ${CMAKE_CURRENT_SOURCE_DIR}/include)
 endfunction()

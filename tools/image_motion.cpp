@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "percentile.h"
+#include "epichead/geometry/so3.h"
 #include "epichead/vision/model_centre.h"
 #include "epichead/vision/pose_estimator.h"
 
@@ -46,7 +47,7 @@ Eigen::Isometry3d ImageMotion::turned(const Eigen::Isometry3d& cam_T_obj, const 
   const Eigen::Vector3d from = camera_->unproject(from_px).normalized();
   const Eigen::Vector3d to = camera_->unproject(*seen_px_).normalized();
   Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
-  turn.linear() = Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
+  turn.linear() = geometry::rotation_between(from, to);
   return turn * cam_T_obj;
 }
 

@@ -36,7 +36,7 @@ NavState nav_state_from(const Eigen::Isometry3d& cam_T_obj) {
 }
 
 Eigen::Matrix3d gravity_frame_from(const Eigen::Vector3d& gravity_obj) {
-  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d(0, 0, -1), gravity_obj).toRotationMatrix();
+  return geometry::rotation_between(Eigen::Vector3d(0, 0, -1), gravity_obj);
 }
 
 void inject(NavState& x, const ErrorVector& dx) {

@@ -66,4 +66,8 @@ Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi) { return so3_left
 
 Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi) { return so3_left_jacobian_inverse(-phi); }
 
+Eigen::Matrix3d rotation_between(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  return Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
+}
+
 }  // namespace epichead::geometry

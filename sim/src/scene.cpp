@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "epichead/geometry/so3.h"
+
 namespace epichead::sim {
 namespace {
 
@@ -138,7 +140,7 @@ Mesh mesh_from_model(const vision::CadModel& model, const std::vector<int>& face
     const double length = axis.norm();
     if (length <= 0 || cyl.radius_m <= 0) continue;
     Eigen::Isometry3d frame_T_part = Eigen::Isometry3d::Identity();
-    frame_T_part.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis / length).toRotationMatrix();
+    frame_T_part.linear() = geometry::rotation_between(Eigen::Vector3d::UnitZ(), axis / length);
     frame_T_part.translation() = cyl.axis_a_obj;
     add_frustum(mesh, frame_T_part, cyl.radius_m, cyl.radius_m, length, cylinder_segments, Caps::Both,
                 material_of(model.faces.size() + static_cast<std::size_t>(&cyl - model.cylinders.data())));

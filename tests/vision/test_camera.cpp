@@ -354,7 +354,7 @@ TEST_CASE("the fisheye model unprojects as cv::fisheye::undistortPoints, out to 
 
 TEST_CASE("the fisheye model's Jacobian matches finite differences, on the axis too") {
   const Camera cam = fisheye_camera();
-  for (const Eigen::Vector2d xn : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1e-9, -2e-9), Eigen::Vector2d(0.3, -0.2),
+  for (const Eigen::Vector2d& xn : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1e-9, -2e-9), Eigen::Vector2d(0.3, -0.2),
                                    Eigen::Vector2d(-2.5, 4.0)}) {
     const Eigen::Matrix2d J = cam.normalized_to_pixel_jacobian(xn);
     constexpr double h = 1e-6;

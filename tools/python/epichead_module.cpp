@@ -35,12 +35,12 @@ py::object to_python(const nlohmann::json& j) {
     case nlohmann::json::value_t::array: {
       py::list l;
       for (const auto& v : j) l.append(to_python(v));
-      return std::move(l);
+      return l;
     }
     case nlohmann::json::value_t::object: {
       py::dict d;
       for (const auto& [k, v] : j.items()) d[py::str(k)] = to_python(v);
-      return std::move(d);
+      return d;
     }
     default: return py::none();  // binary, discarded: never in a report
   }

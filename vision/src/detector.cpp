@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "detector_impl.h"
+#include "epichead/geometry/so3.h"
 #include "hypothesis_places.h"
 #include "view_sphere.h"
 
@@ -89,7 +90,7 @@ std::vector<Eigen::Isometry3d> Detector::Impl::hypotheses(const std::vector<cv::
     // turn the whole template pose by the rotation taking the axis onto that ray.
     const Eigen::Vector3d ray = camera.unproject(c).normalized();
     Eigen::Isometry3d T = template_pose(s.view, s.roll, s.distance_m);
-    const Eigen::Matrix3d align = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
+    const Eigen::Matrix3d align = geometry::rotation_between(Eigen::Vector3d::UnitZ(), ray);
     T.linear() = align * T.linear();
     T.translation() = ray * s.distance_m - T.linear() * centre_obj;
     if (prior.up_cam && prior.up_obj && angle_deg(T.linear() * *prior.up_obj, *prior.up_cam) > options.up_tolerance_deg) continue;

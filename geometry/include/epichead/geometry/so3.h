@@ -30,4 +30,10 @@ Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi);
 // Jr(phi)^-1 = Jl(-phi)^-1; |phi| < 2 pi.
 Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi);
 
+// The smallest rotation that turns the direction of `from` into that of `to` (Eigen's
+// Quaterniond::FromTwoVectors; neither may be zero). One definition for every caller: the SVD
+// Eigen keeps for opposite directions costs each file that instantiates it about 16 s to compile
+// under the sanitizers.
+Eigen::Matrix3d rotation_between(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
 }  // namespace epichead::geometry
