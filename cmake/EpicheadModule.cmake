@@ -1,7 +1,8 @@
 # epichead_module(NAME <lib> DEPS <targets...> [PCH <parts...>]): one static library per
-# top-level folder, sources from src/, public headers from include/; PCH names the libraries
-# whose headers its precompiled header holds (epichead_precompile, PrecompiledHeaders.cmake). A module without sources yet is an
-# interface target, so the dependency graph stays the same while it is being written.
+# top-level folder, sources from src/, public headers from include/. PCH: a precompiled header
+# of the libraries named (epichead_precompile, PrecompiledHeaders.cmake). A module without
+# sources yet is an interface target, so the dependency graph stays the same while it is being
+# written.
 # Every module is also epichead::<name without the prefix> (the name an installed package's
 # users link, docs/install.md) and is installed with its headers.
 include(GNUInstallDirs)
