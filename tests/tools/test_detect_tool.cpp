@@ -1,8 +1,9 @@
 // Detection without a starting pose, end to end through the program: `detect` on the real tea
 // box video, `track` of the real video with init.csv removed, and re-acquisition after a
-// one-second cover in the simulator. The tea box's templates (a coarse view sphere, --views 1,
-// to keep the sanitizer build quick) are built once by the ctest fixture
-// "tools/detect: tea box templates" (tests/CMakeLists.txt) into the build tree's cache.
+// one-second cover in the simulator. The tea box's and the printed package's templates (a coarse
+// view sphere, --views 1, to keep the sanitizer build quick) are built once by the ctest fixtures
+// "tools/detect: tea box templates" and "tools/detect: package templates" (tests/CMakeLists.txt)
+// into the build tree's cache.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
