@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -71,4 +72,20 @@ TEST_CASE("the left and right Jacobians match numeric derivatives of exp") {
     CHECK(max_abs(so3_left_jacobian_inverse(phi) * so3_left_jacobian(phi) - Eigen::Matrix3d::Identity()) < 1e-8);
     CHECK(max_abs(so3_right_jacobian_inverse(phi) * so3_right_jacobian(phi) - Eigen::Matrix3d::Identity()) < 1e-8);
   }
+}
+
+TEST_CASE("rotation_between turns one direction into another, opposite and equal ones too") {
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), z = Eigen::Vector3d::UnitZ();
+  const std::pair<Eigen::Vector3d, Eigen::Vector3d> pairs[] = {
+      {z, Eigen::Vector3d(1, 2, 3)}, {3 * x, x}, {x, -2 * x}, {z, Eigen::Vector3d(1e-13, 0, -1)}, {Eigen::Vector3d(0, 0, -1), z}};
+  for (const auto& [from, to] : pairs) {
+    INFO("from " << from.transpose() << " to " << to.transpose());
+    const Eigen::Matrix3d R = rotation_between(from, to);
+    CHECK(max_abs(R * R.transpose() - Eigen::Matrix3d::Identity()) < 1e-12);
+    CHECK(R.determinant() == Approx(1.0).margin(1e-12));
+    CHECK(max_abs(R * from.normalized() - to.normalized()) < 1e-12);
+  }
+  // The smallest such rotation: its angle is the one between the directions.
+  const Eigen::Vector3d to(1, 2, 3);
+  CHECK(so3_log(rotation_between(z, to)).norm() == Approx(std::acos(to.normalized().z())).margin(1e-12));
 }
