@@ -1,5 +1,6 @@
 // SO(3): exp and log invert each other from zero to near pi, exp is Eigen's angle-axis rotation,
-// and the left and right Jacobians (and their inverses) match numeric derivatives.
+// and the left and right Jacobians (and their inverses) match numeric derivatives; rotation_between
+// turns one direction into another.
 #include <catch2/catch.hpp>
 
 #include <cmath>
