@@ -3,6 +3,8 @@
 // wrong lock (tools/track_acquisition.h). A pose is provisional for provisional_s after it was
 // found by detection, or after a degraded frame: every recheck_interval_s meanwhile the search
 // runs again, and the caller switches to what it finds when that explains a much longer outline.
+// A found pose's first recheck comes sooner: a start found while the object was still entering
+// the view is as doubtful as a pose gets, and the frames after it show the object whole.
 // So is a pose after a doubtful frame: a degraded one, or the first tracked again after a loss
 // (re-locked from the prediction, not found by detection). Its first recheck is on that frame.
 // No detection here: only the times.
@@ -15,6 +17,8 @@ namespace epichead::tools {
 struct RecheckOptions {
   double provisional_s = 3.0;        // <= 0: no rechecks at all
   double recheck_interval_s = 0.5;
+  // After a pose found by detection, the first recheck this soon (then every interval).
+  double first_recheck_s = 0.1;
   // Without the IMU, a burst the constant-velocity prediction cannot follow leaves the tracker on
   // a wrong lock that it then reports as tracked; the degraded frames, or lost frames it then
   // re-locks from, on the way there are the only sign, and detection the only thing that tells
@@ -26,10 +30,10 @@ class RecheckSchedule {
  public:
   explicit RecheckSchedule(const RecheckOptions& options = {}) : options_(options) {}
 
-  // A pose found by detection at t_s: provisional from now, first recheck an interval later.
+  // A pose found by detection at t_s: provisional from now, first recheck first_recheck_s later.
   void found_at(double t_s) {
     provisional_until_s_ = t_s + options_.provisional_s;
-    next_s_ = t_s + options_.recheck_interval_s;
+    next_s_ = t_s + options_.first_recheck_s;
   }
   // After the tracker's frame at t_s: whether the search runs on it. A doubtful frame (degraded,
   // or `relocked`: tracked again from the prediction after lost frames) outside a provisional

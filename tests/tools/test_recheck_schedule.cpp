@@ -1,7 +1,7 @@
 // When `epichead track` reruns detection on a frame it tracks (tools/recheck_schedule.h): for a
 // while after a detected start or a doubtful frame (degraded, or re-locked after a loss), every
-// interval; a doubtful frame's first recheck is on that frame; lost frames never, and nothing
-// when turned off.
+// interval; a detected pose's first recheck a tenth of a second after it, a doubtful frame's on
+// that frame; lost frames never, and nothing when turned off.
 #include <catch2/catch.hpp>
 
 #include "recheck_schedule.h"
@@ -22,12 +22,17 @@ std::vector<int> due_frames(RecheckSchedule& s, TrackStatus status, double t0_s,
 
 }  // namespace
 
-TEST_CASE("recheck schedule: a detected start is rechecked every half second for three seconds") {
+TEST_CASE("recheck schedule: a detected start is rechecked after a tenth of a second, then every half second for three seconds") {
   RecheckSchedule s;
   CHECK(due_frames(s, TrackStatus::Tracked, 0.0, 30).empty());  // nothing found yet
   s.found_at(1.0);
-  CHECK(due_frames(s, TrackStatus::Tracked, 1.0, 120) == std::vector<int>{15, 30, 45, 60, 75, 90});
+  CHECK(due_frames(s, TrackStatus::Tracked, 1.0, 120) == std::vector<int>{3, 18, 33, 48, 63, 78});
   CHECK(s.started_after_doubt() == 0);
+  RecheckOptions even;
+  even.first_recheck_s = even.recheck_interval_s;
+  RecheckSchedule t(even);
+  t.found_at(1.0);
+  CHECK(due_frames(t, TrackStatus::Tracked, 1.0, 120) == std::vector<int>{15, 30, 45, 60, 75, 90});
 }
 
 TEST_CASE("recheck schedule: a degraded frame is rechecked at once and then as a detected start, lost frames never") {
