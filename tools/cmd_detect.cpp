@@ -51,6 +51,25 @@ std::optional<std::pair<double, double>> error_to_truth(const Sequence& seq, int
   return std::nullopt;
 }
 
+// Which of the verification's tests a hypothesis failed, with its measure and the limit.
+std::string refusal(const vision::DetectionHypothesis& h, const vision::DetectorOptions& o) {
+  std::string why;
+  char part[128];
+  const auto add = [&](bool failed, const char* format, double value, double limit) {
+    if (!failed) return;
+    std::snprintf(part, sizeof part, format, value, limit);
+    why += (why.empty() ? "" : ", ") + std::string(part);
+  };
+  add(h.support < o.min_support, "support %.2f below %.2f", h.support, o.min_support);
+  add(h.supported_px < o.min_supported_px, "supported outline %.0f px below %.0f px", h.supported_px, o.min_supported_px);
+  add(h.colour_continuation > o.max_colour_continuation, "its outline runs on %.2f, above %.2f", h.colour_continuation,
+      o.max_colour_continuation);
+  add(h.unsupported_edge_share > o.max_unsupported_edge_share, "%.2f of its outline on unsupported edges, above %.2f",
+      h.unsupported_edge_share, o.max_unsupported_edge_share);
+  if (why.empty()) why = "part of the model outside the image";
+  return why;
+}
+
 int run_detect(const DetectArgs& a) {
   const char* cmd = "detect";
   if (a.imu != "on" && a.imu != "off") return fail(cmd, "--imu must be on or off, got '" + a.imu + "'");
@@ -129,6 +148,8 @@ int run_detect(const DetectArgs& a) {
     e["score"] = h.score;
     e["supported_px"] = h.supported_px;
     e["colour_continuation"] = h.colour_continuation;
+    e["unsupported_edge_share"] = h.unsupported_edge_share;
+    e["weakest_edge_support"] = h.weakest_edge_support;
     e["similarity"] = h.similarity;
     e["status"] = to_string(h.status);
     e["start"] = pose_json(h.start_cam_T_obj);
@@ -194,12 +215,9 @@ int run_detect(const DetectArgs& a) {
               result->matches, result->hypotheses.size(), result->match_ms, result->refine_ms);
   if (const auto err = truth_error(result->best.cam_T_obj))
     std::printf("against gt.csv: %.2f deg, %.1f mm\n", err->first, err->second);
-  if (!result->found) {
-    char why[96];
-    std::snprintf(why, sizeof why, " (best support %.2f, its outline runs on %.2f, at most %.2f)", result->best.support,
-                  result->best.colour_continuation, a.detection.options.max_colour_continuation);
-    return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + why + "; see " + png_path);
-  }
+  if (!result->found)
+    return fail(cmd, "the object was not found in frame " + std::to_string(entry.frame) + " (best hypothesis: " +
+                         refusal(result->best, a.detection.options) + "); see " + png_path);
   const std::string pose_path = (fs::path(a.out) / "pose.csv").string();
   if (auto ok = write_pose_csv(pose_path, {{entry.frame, entry.t_s, result->best.cam_T_obj, ""}}); !ok) return fail(cmd, ok.error());
   std::printf("wrote %s, %s, %s\n", pose_path.c_str(), json_path.c_str(), png_path.c_str());

@@ -39,6 +39,10 @@ void add_detection_options(CLI::App& app, DetectionArgs& a) {
                  "corners, relative to along it, for a pose to count as found (a model laid on a facade's lines "
                  "finds them running on; 2 turns the test off)")
       ->check(CLI::Range(0.0, 2.0));
+  app.add_option("--max-unsupported-edges", a.options.max_unsupported_edge_share,
+                 "Detection: the largest share of the model's outline that may lie on edges an image edge "
+                 "hardly supports (under a quarter of their length) for a pose to count as found (1 turns the test off)")
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 std::expected<std::unique_ptr<vision::Detector>, std::string> make_detector(const std::string& command,

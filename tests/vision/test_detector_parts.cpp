@@ -157,6 +157,27 @@ TEST_CASE("edge support: a drawn outline supports its own pose fully, a blank im
   EdgeGradients blank;
   blank.compute(cv::Mat::zeros(cam.height_px(), cam.width_px(), CV_8UC1));
   CHECK(edge_support(blank, seen).share == 0.0);
+
+  // Edge by edge: every edge of the drawn outline is supported; an edge laid where the image is
+  // blank is not, and its samples are the share of the outline on unsupported edges.
+  CHECK(at_pose.unsupported_edge_share == 0.0);
+  CHECK(at_pose.weakest_edge_support > 0.9);
+  VisibleModel with_blank_edge = seen;
+  REQUIRE_FALSE(seen.edges.empty());
+  VisibleEdge lone = seen.edges.front();
+  lone.a_px = {40, 20};
+  lone.b_px = {240, 20};  // 200 px along the top, where nothing is drawn
+  with_blank_edge.edges.push_back(lone);
+  const EdgeSupport with_lone = edge_support(g, with_blank_edge);
+  const long lone_samples = with_lone.samples - at_pose.samples;
+  CHECK(lone_samples > 60);
+  CHECK(with_lone.unsupported_edge_share == Approx(static_cast<double>(lone_samples) / with_lone.samples));
+  CHECK(with_lone.weakest_edge_support == 0.0);
+  // A short edge (under min_edge_samples) is counted in the share but not judged alone.
+  VisibleModel with_short_edge = seen;
+  lone.b_px = {60, 20};
+  with_short_edge.edges.push_back(lone);
+  CHECK(edge_support(g, with_short_edge).unsupported_edge_share == 0.0);
 }
 
 TEST_CASE("colour continuation: across the outline's lines the colours differ along the object and stop differing past it") {

@@ -166,6 +166,8 @@ DetectionHypothesis Detector::Impl::measure(DetectionHypothesis h, bool whole_ob
     h.support = support.share;
     h.score = support.share * static_cast<double>(support.supported);
     h.supported_px = static_cast<double>(support.supported) * so.step_px;
+    h.unsupported_edge_share = support.unsupported_edge_share;
+    h.weakest_edge_support = support.weakest_edge_support;
     h.colour_continuation = detail::colour_continuation(colour, visible).ratio;
   }
   return h;

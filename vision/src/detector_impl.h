@@ -127,7 +127,8 @@ struct Detector::Impl {
   void choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const;
   bool runs_on(const DetectionHypothesis& h) const { return h.colour_continuation > options.max_colour_continuation; }
   bool verified(const DetectionHypothesis& h) const {
-    return h.support >= options.min_support && h.supported_px >= options.min_supported_px && !runs_on(h);
+    return h.support >= options.min_support && h.supported_px >= options.min_supported_px && !runs_on(h) &&
+           h.unsupported_edge_share <= options.max_unsupported_edge_share;
   }
 };
 

@@ -20,6 +20,22 @@ struct Counter {
   const EdgeSupportOptions& o;
   double min_sq, min_cos;
   long samples = 0, supported = 0;
+  long judged = 0, unsupported = 0;  // samples on edges judged alone, and on weak ones
+  double weakest = 1;
+  long edge_samples0 = 0, edge_supported0 = 0;
+
+  void begin_edge() {
+    edge_samples0 = samples;
+    edge_supported0 = supported;
+  }
+  void end_edge() {
+    const long n = samples - edge_samples0;
+    if (n < o.min_edge_samples) return;
+    const double share = static_cast<double>(supported - edge_supported0) / static_cast<double>(n);
+    judged += n;
+    if (share < o.weak_edge_share) unsupported += n;
+    weakest = std::min(weakest, share);
+  }
 
   // One sample at p with unit normal n.
   void sample(double px, double py, double nx, double ny) {
@@ -52,16 +68,19 @@ EdgeSupport edge_support(const EdgeGradients& gradients, const VisibleModel& vis
     if (!(len > 2 * options.step_px)) continue;
     const Eigen::Vector2d n(-d.y() / len, d.x() / len);
     // Ends left out: corners mix two edges' gradients.
+    c.begin_edge();
     for (double s = options.step_px; s < len - options.step_px + 1e-9; s += options.step_px) {
       const Eigen::Vector2d p = e.a_px + d * (s / len);
       c.sample(p.x(), p.y(), n.x(), n.y());
     }
+    c.end_edge();
   }
   for (const auto& el : visible.ellipses) {
     const double perimeter = 2 * M_PI * std::sqrt(0.5 * (el.semi_major_px * el.semi_major_px + el.semi_minor_px * el.semi_minor_px));
     if (!(perimeter > 4 * options.step_px) || !std::isfinite(perimeter)) continue;
     const int n = static_cast<int>(perimeter / options.step_px);
     const double ca = std::cos(el.angle_rad), sa = std::sin(el.angle_rad);
+    c.begin_edge();
     for (int i = 0; i < n; ++i) {
       const double t = 2 * M_PI * i / n;
       const double ex = el.semi_major_px * std::cos(t), ey = el.semi_minor_px * std::sin(t);
@@ -72,9 +91,12 @@ EdgeSupport edge_support(const EdgeGradients& gradients, const VisibleModel& vis
       ny /= nn;
       c.sample(el.centre_px.x() + ca * ex - sa * ey, el.centre_px.y() + sa * ex + ca * ey, ca * nx - sa * ny, sa * nx + ca * ny);
     }
+    c.end_edge();
   }
   EdgeSupport out{c.samples, c.supported, 0.0};
   if (c.samples >= options.min_samples) out.share = static_cast<double>(c.supported) / static_cast<double>(c.samples);
+  if (c.judged > 0) out.unsupported_edge_share = static_cast<double>(c.unsupported) / static_cast<double>(c.judged);
+  out.weakest_edge_support = c.weakest;
   return out;
 }
 

@@ -20,12 +20,19 @@ struct EdgeSupportOptions {
   double min_gradient = 48.0;    // Sobel 3x3 magnitude (8x the grey levels per pixel)
   double max_angle_deg = 25.0;   // between the image gradient and the edge's normal
   int min_samples = 24;          // fewer: the model is too small to verify, support 0
+  // Edges (and ellipses) with at least this many samples are judged one by one as well.
+  int min_edge_samples = 8;
+  double weak_edge_share = 0.25;  // an edge whose own support is below this is unsupported
 };
 
 struct EdgeSupport {
   long samples = 0, supported = 0;
   // Supported samples / samples (0 when there are fewer than min_samples).
   double share = 0;
+  // Of the samples on edges long enough to judge alone, the share on edges whose own support
+  // is below weak_edge_share, and the lowest support of such an edge (1 when none is judged).
+  double unsupported_edge_share = 0;
+  double weakest_edge_support = 1;
 };
 
 // Samples every visible edge and ellipse.

@@ -68,6 +68,13 @@ struct DetectorOptions {
   // A test of the best hypothesis only: passing over it to the next one made wrong poses found
   // where none was before (docs/detection.md).
   double max_colour_continuation = 0.8;
+  // ... and the outline is not made of a few supported lines beside unsupported ones: at most
+  // this share of it (on edges long enough to judge alone) may lie on edges that an image edge
+  // supports on less than a quarter of their length. The object's own outline has every edge
+  // seen, but where another object's lines and a picture's border make a box (can scenes, a
+  // bowl: 0.23-0.39 on development seeds; the object itself at most 0.21, the mockup's many
+  // small edges). 1 turns the test off.
+  double max_unsupported_edge_share = 0.25;
 };
 
 // A pose found in one frame.
@@ -85,6 +92,10 @@ struct DetectionHypothesis {
   // relative to along the object (edge_support.h, colour_continuation; about 0 for an object
   // in front of its background, near 1 when the outline lies on lines that run on).
   double colour_continuation = 0;
+  // Of the outline on edges long enough to judge alone (24 px), the share on edges an image
+  // edge supports on less than a quarter of their length, and the lowest support of one.
+  double unsupported_edge_share = 0;
+  double weakest_edge_support = 1;
   TrackStatus status = TrackStatus::Lost;  // of the last refinement step
 };
 
