@@ -30,7 +30,7 @@ struct EdgeSupport {
   // Supported samples / samples (0 when there are fewer than min_samples).
   double share = 0;
   // Of the samples on edges long enough to judge alone, the share on edges whose own support
-  // is below weak_edge_share, and the lowest support of such an edge (1 when none is judged).
+  // is below weak_edge_share; and the lowest own support of an edge judged alone (1 when none is).
   double unsupported_edge_share = 0;
   double weakest_edge_support = 1;
 };

@@ -70,10 +70,10 @@ struct DetectorOptions {
   double max_colour_continuation = 0.8;
   // ... and the outline is not made of a few supported lines beside unsupported ones: at most
   // this share of it (on edges long enough to judge alone) may lie on edges that an image edge
-  // supports on less than a quarter of their length. The object's own outline has every edge
-  // seen, but where another object's lines and a picture's border make a box (can scenes, a
-  // bowl: 0.23-0.39 on development seeds; the object itself at most 0.21, the mockup's many
-  // small edges). 1 turns the test off.
+  // supports on less than a quarter of their length. The object's own outline has its edges
+  // seen (at most 0.21 on development seeds: the mockup's many small edges); a box made of
+  // other objects' lines often has not (the wrong poses found there: up to 0.39). 1 turns the
+  // test off.
   double max_unsupported_edge_share = 0.25;
 };
 
