@@ -51,22 +51,22 @@ std::optional<std::pair<double, double>> error_to_truth(const Sequence& seq, int
   return std::nullopt;
 }
 
-// Which of the verification's tests a hypothesis failed, with its measure and the limit.
+// Which of the verification's tests a hypothesis failed (vision::failed_detection_tests), each
+// with its measure and the limit.
 std::string refusal(const vision::DetectionHypothesis& h, const vision::DetectorOptions& o) {
+  const unsigned failed = vision::failed_detection_tests(h, o);
   std::string why;
   char part[128];
-  const auto add = [&](bool failed, const char* format, double value, double limit) {
-    if (!failed) return;
+  const auto add = [&](unsigned test, const char* format, double value, double limit) {
+    if (!(failed & test)) return;
     std::snprintf(part, sizeof part, format, value, limit);
     why += (why.empty() ? "" : ", ") + std::string(part);
   };
-  add(h.support < o.min_support, "support %.2f below %.2f", h.support, o.min_support);
-  add(h.supported_px < o.min_supported_px, "supported outline %.0f px below %.0f px", h.supported_px, o.min_supported_px);
-  add(h.colour_continuation > o.max_colour_continuation, "its outline runs on %.2f, above %.2f", h.colour_continuation,
-      o.max_colour_continuation);
-  add(h.unsupported_edge_share > o.max_unsupported_edge_share, "%.2f of its outline on unsupported edges, above %.2f",
-      h.unsupported_edge_share, o.max_unsupported_edge_share);
-  if (why.empty()) why = "part of the model outside the image";
+  add(vision::kTooLittleSupport, "support %.2f below %.2f", h.support, o.min_support);
+  add(vision::kTooShortOutline, "supported outline %.0f px below %.0f px", h.supported_px, o.min_supported_px);
+  add(vision::kOutlineRunsOn, "its outline runs on %.2f, above %.2f", h.colour_continuation, o.max_colour_continuation);
+  add(vision::kUnsupportedEdges, "%.2f of its outline on unsupported edges, above %.2f", h.unsupported_edge_share,
+      o.max_unsupported_edge_share);
   return why;
 }
 

@@ -173,6 +173,15 @@ DetectionHypothesis Detector::Impl::measure(DetectionHypothesis h, bool whole_ob
   return h;
 }
 
+unsigned failed_detection_tests(const DetectionHypothesis& h, const DetectorOptions& o) {
+  unsigned failed = 0;
+  if (!(h.support >= o.min_support)) failed |= kTooLittleSupport;
+  if (!(h.supported_px >= o.min_supported_px)) failed |= kTooShortOutline;
+  if (h.colour_continuation > o.max_colour_continuation) failed |= kOutlineRunsOn;
+  if (!(h.unsupported_edge_share <= o.max_unsupported_edge_share)) failed |= kUnsupportedEdges;
+  return failed;
+}
+
 void Detector::Impl::choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const {
   if (symmetries.empty()) return;
   if (const auto& like = prior.orient_like ? prior.orient_like : prior.near_cam_T_obj; like)

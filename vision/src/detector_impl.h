@@ -125,11 +125,7 @@ struct Detector::Impl {
   // the world's.
   // A can found again after a cover is otherwise as likely upside down (issue 19).
   void choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const;
-  bool runs_on(const DetectionHypothesis& h) const { return h.colour_continuation > options.max_colour_continuation; }
-  bool verified(const DetectionHypothesis& h) const {
-    return h.support >= options.min_support && h.supported_px >= options.min_supported_px && !runs_on(h) &&
-           h.unsupported_edge_share <= options.max_unsupported_edge_share;
-  }
+  bool verified(const DetectionHypothesis& h) const { return failed_detection_tests(h, options) == 0; }
 };
 
 

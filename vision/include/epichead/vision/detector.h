@@ -99,6 +99,15 @@ struct DetectionHypothesis {
   TrackStatus status = TrackStatus::Lost;  // of the last refinement step
 };
 
+// The verification's tests (DetectorOptions) a hypothesis fails, as bits; none: it is found.
+enum DetectionTest : unsigned {
+  kTooLittleSupport = 1u << 0,  // support below min_support (0 also when part of the model is outside the image)
+  kTooShortOutline = 1u << 1,   // supported_px below min_supported_px
+  kOutlineRunsOn = 1u << 2,     // colour_continuation above max_colour_continuation
+  kUnsupportedEdges = 1u << 3,  // unsupported_edge_share above max_unsupported_edge_share
+};
+unsigned failed_detection_tests(const DetectionHypothesis& h, const DetectorOptions& options);
+
 struct DetectionResult {
   bool found = false;
   DetectionHypothesis best;
