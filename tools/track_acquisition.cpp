@@ -22,6 +22,7 @@ RecheckOptions recheck_options(const AcquisitionOptions& o) {
 TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
                                    const AcquisitionOptions& options)
     : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)),
+      switch_(options.switching),
       centre_obj_(vision::model_centre(seq.model())) {
   if (auto up = object_up(options.detection); up) up_obj_ = *up;
 }
@@ -63,6 +64,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   if (r && *r) {
     start_frame_ = frame_number;
     rechecks_due_.found_at(t_s);
+    switch_.forget();
   }
   return r;
 }
@@ -96,6 +98,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   if (r && *r) {
     ++reacquired_;
     rechecks_due_.found_at(t_s);
+    switch_.forget();
     orient_ref_.reset();
     frames_to_reacquire_.push_back(lost_run_);
     lost_run_ = 0;
@@ -113,8 +116,11 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
   if (!found) return found;
   const auto now = detector_->verify(frame, tracked);
   if (!now) return std::unexpected(now.error());
-  recheck_log_.push_back({{"t_s", t_s}, {"found", found->has_value()}, {"found_score", last_score_}, {"tracked_score", now->score}});
-  if (!*found || last_score_ < options_.switch_ratio * now->score) return std::optional<Eigen::Isometry3d>{};
+  const unsigned refused = vision::failed_detection_tests(*now, options_.detection.options) & ~vision::kTooShortOutline;
+  const bool take = switch_.take(t_s, found->has_value(), last_score_, now->score, refused != 0);
+  recheck_log_.push_back({{"t_s", t_s}, {"found", found->has_value()}, {"found_score", last_score_}, {"tracked_score", now->score},
+                          {"tracked_support", now->support}, {"tracked_refused", refused != 0}, {"switched", take}});
+  if (!take) return std::optional<Eigen::Isometry3d>{};
   ++switches_;
   rechecks_due_.found_at(t_s);
   orient_ref_.reset();

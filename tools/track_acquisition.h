@@ -15,6 +15,7 @@
 
 #include "detection_setup.h"
 #include "recheck_schedule.h"
+#include "recheck_switch.h"
 #include "track_prediction.h"
 #include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
@@ -28,12 +29,12 @@ struct AcquisitionOptions {
   bool reacquire = true;             // detect after a loss (false: retry from the last pose only)
   int lost_frames_before_detection = 3;
   // While a pose is provisional (recheck_schedule.h: found by detection, or after a doubtful
-  // frame: degraded, or re-locked after a loss) the whole search runs again every so often, and a pose that explains a much longer
-  // outline than the tracked one (score at least switch_ratio times) takes over. Clutter can hold
-  // a box-like outline (a printed rectangle) before the object itself comes into view
-  // (late_entry).
+  // frame: degraded, or re-locked after a loss) the whole search runs again every so often, and a
+  // pose that explains a much longer outline than the tracked one takes over (recheck_switch.h).
+  // Clutter can hold a box-like outline (a printed rectangle) before the object itself comes into
+  // view (late_entry).
   RecheckOptions recheck;
-  double switch_ratio = 1.5;
+  SwitchOptions switching;
 };
 
 class TrackAcquisition {
@@ -79,6 +80,7 @@ class TrackAcquisition {
   int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
   bool in_loss_ = false;
   RecheckSchedule rechecks_due_;
+  RecheckSwitch switch_;
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
   std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a doubtful frame started
   Eigen::Vector3d centre_obj_;  // vision::model_centre: levelled poses turn about it

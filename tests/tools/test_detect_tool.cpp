@@ -267,6 +267,9 @@ TEST_CASE("track by constant velocity alone (--image-motion off) rechecks a pose
   INFO(acq.dump());
   CHECK(acq["recheck_stretches_after_doubt"].get<int>() >= 1);
   CHECK(acq["switches"].get<int>() >= 1);
+  int switched = 0;  // the log says which rechecks switched
+  for (const auto& r : acq["recheck_log"]) switched += r.at("switched").get<bool>() ? 1 : 0;
+  CHECK(switched == acq["switches"].get<int>());
   const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " +
                                            q(tmp / "per_frame.csv") + " --json");
   REQUIRE(score.exit_code == 0);
