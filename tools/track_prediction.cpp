@@ -227,6 +227,10 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     return predictor_.tilt_error_rad(t_s, cam_T_obj);
   }
+  void replace_wrong_lock(double t_s, const Eigen::Isometry3d& cam_T_obj, double lock_since_s) override {
+    feed_until(t_s);
+    predictor_.replace_wrong_lock(t_s, cam_T_obj, lock_since_s);
+  }
   std::optional<Upright> upright(double t_s) const override {
     const auto down_cam = predictor_.measured_down_cam(t_s);
     const auto down_obj = predictor_.learnt_down_obj();
@@ -327,6 +331,7 @@ class ImuPredictor final : public TrackPredictor {
     // The velocity, biases and gravity learnt so far carry over; only the clock changes.
     if (const auto motion = predictor_.state()) p->carry_motion(*motion, predictor_.covariance());
     p->carry_learnt_gravity(predictor_);
+    p->carry_counters(predictor_);
     predictor_ = std::move(*p);
     const auto& imu = *imu_;
     next_ = 0;

@@ -59,6 +59,14 @@ class TrackPredictor {
     (void)cam_T_obj;
     return std::nullopt;
   }
+  // A recheck replaced the tracked pose, in doubt since lock_since_s, by `cam_T_obj` at t_s (before
+  // restart()): with the IMU, a down learnt since then that the pose contradicts was the lock's
+  // and is forgotten (fusion::Predictor::replace_wrong_lock).
+  virtual void replace_wrong_lock(double t_s, const Eigen::Isometry3d& cam_T_obj, double lock_since_s) {
+    (void)t_s;
+    (void)cam_T_obj;
+    (void)lock_since_s;
+  }
   // With the IMU and the object's down learnt: which way is up at t_s, for detection.
   virtual std::optional<Upright> upright(double t_s) const {
     (void)t_s;

@@ -29,6 +29,7 @@ void LearntGravity::learn(double t_s, const Eigen::Vector3d& down_obj, double si
   const Eigen::Vector3d d = down_obj.normalized();
   if (!learnt_) {
     down_obj_ = d;
+    learnt_since_s_ = t_s;
   } else {
     const double a = std::clamp((t_s - learnt_t_s_) / options_.learn_time_s, 0.0, 1.0);
     down_obj_ = ((1 - a) * down_obj_ + a * d).normalized();
@@ -68,6 +69,13 @@ void LearntGravity::note_verdict(double t_s, bool contradicts) {
     contradicted_since_s_ = -1;
     ++forgotten_;
   }
+}
+
+void LearntGravity::forget_learnt() {
+  if (!learnt_ || told_) return;
+  learnt_ = false;
+  contradicted_since_s_ = -1;
+  ++forgotten_;
 }
 
 std::optional<MeanForce> mean_specific_force(const StateHistory& history, double t_s, double window_s, double min_window_s,

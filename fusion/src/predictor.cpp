@@ -385,6 +385,15 @@ std::optional<double> Predictor::tilt_error_rad(double t_s, const Eigen::Isometr
 
 bool Predictor::check_tilt(double t_s, const Eigen::Isometry3d& cam_T_obj) { return check_tilt(t_s, tilt_error_rad(t_s, cam_T_obj)); }
 
+bool Predictor::replace_wrong_lock(double t_s, const Eigen::Isometry3d& cam_T_obj, double lock_since_s) {
+  if (!gravity_.learnt() || gravity_.told() || gravity_.learnt_since_s() < lock_since_s) return false;
+  const auto e = tilt_error_rad(t_s, cam_T_obj);
+  if (!e || !(*e > options_.gravity_check.max_tilt_error_rad)) return false;
+  gravity_.forget_learnt();
+  ++status_.counters.gravity_forgotten;
+  return true;
+}
+
 bool Predictor::check_tilt(double t_s, std::optional<double> e) {
   if (!e) return false;
   const bool against = *e > options_.gravity_check.max_tilt_error_rad;

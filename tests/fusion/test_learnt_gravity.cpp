@@ -271,3 +271,42 @@ TEST_CASE("a told down of zero length or not finite is refused") {
   options.gravity_check.told_down_obj = Eigen::Vector3d(0, 0, std::nan(""));
   CHECK_FALSE(Predictor::create(options));
 }
+
+TEST_CASE("a down learnt from a wrong lock is forgotten when the pose replacing the lock contradicts it, and kept when it agrees, was learnt before the lock or was told") {
+  Tracked run(2.0);  // learnt after 30 poses, about 1.2 s
+  REQUIRE(run.predictor.learnt_down_obj());
+  const double t = run.t_s;
+  const Eigen::Isometry3d truth = run.traj.at(t).x.cam_T_obj();
+  const Eigen::Vector3d across = (truth.linear() * run.true_down_obj()).unitOrthogonal();
+  const Eigen::Isometry3d tilted = turned(truth, across, 20 * deg);
+  // The replacing pose agrees (a few degrees): the down stays.
+  CHECK_FALSE(run.predictor.replace_wrong_lock(t, turned(truth, across, 4 * deg), 0.2));
+  // Tilted 20 deg, but the lock began after the down was learnt: the pose is the likelier error.
+  CHECK_FALSE(run.predictor.replace_wrong_lock(t, tilted, 1.5));
+  CHECK(run.predictor.learnt_down_obj());
+  // Tilted 20 deg from a down learnt while the lock was held: it was the lock's.
+  CHECK(run.predictor.replace_wrong_lock(t, tilted, 0.2));
+  CHECK_FALSE(run.predictor.learnt_down_obj());
+  CHECK(run.predictor.status(t).counters.gravity_forgotten == 1);
+  CHECK_FALSE(run.predictor.replace_wrong_lock(t, tilted, 0.2));  // nothing left to forget
+
+  // A told down is the user's: kept.
+  PredictorOptions told;
+  told.gravity_check.told_down_obj = Tracked(0.1).true_down_obj();
+  Tracked user(2.0, told);
+  REQUIRE(user.predictor.learnt_down_obj());
+  const Eigen::Isometry3d truth2 = user.traj.at(user.t_s).x.cam_T_obj();
+  CHECK_FALSE(user.predictor.replace_wrong_lock(user.t_s, turned(truth2, (truth2.linear() * user.true_down_obj()).unitOrthogonal(), 20 * deg), 0.0));
+  CHECK(user.predictor.learnt_down_obj());
+}
+
+TEST_CASE("a predictor restarted on a corrected clock goes on from the counters of the one it replaces") {
+  Tracked run(1.0);
+  const auto before = run.predictor.status(run.t_s).counters;
+  REQUIRE(before.vision_applied > 20);
+  auto restarted = *Predictor::create(PredictorOptions{});
+  restarted.carry_learnt_gravity(run.predictor);
+  restarted.carry_counters(run.predictor);
+  CHECK(restarted.status(run.t_s).counters.vision_applied == before.vision_applied);
+  CHECK(restarted.status(run.t_s).counters.imu_accepted == before.imu_accepted);
+}

@@ -59,8 +59,14 @@ class LearntGravity {
   // A pose at t_s was found to contradict (true) or agree with (false) gravity; forgets the learnt
   // down after forget_after_s of contradictions with none agreeing.
   void note_verdict(double t_s, bool contradicts);
+  // The poses it was learnt from were a wrong lock (a recheck found the object elsewhere): the
+  // learnt down is forgotten and learnt again. A told one is kept (the caller decides whether the
+  // down was the lock's: learnt_since_s()).
+  void forget_learnt();
 
   bool learnt() const { return learnt_; }
+  // When the down now held was first learnt (not told); meaningless before.
+  double learnt_since_s() const { return learnt_since_s_; }
   // The down is the told one (not yet forgotten).
   bool told() const { return told_; }
   // gyro_bias_radps() and accel_bias_mps2() come from the filter (a told down has none at first).
@@ -84,6 +90,7 @@ class LearntGravity {
   Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_mps2_ = Eigen::Vector3d::Zero();
   double learnt_t_s_ = 0;
+  double learnt_since_s_ = 0;
   double contradicted_since_s_ = -1;  // first contradiction of the current run; < 0: none
   int forgotten_ = 0;
 };

@@ -73,7 +73,7 @@ struct PredictorCounters {
   std::uint64_t vision_applied = 0, vision_initialised = 0, vision_gated = 0, vision_too_old = 0,
                 vision_out_of_order = 0, vision_bad_input = 0, vision_no_imu = 0;
   std::uint64_t vision_against_gravity = 0;  // poses check_tilt() or a re-initialisation found tilted
-  std::uint64_t gravity_forgotten = 0;       // learnt downs forgotten after a long run of contradictions
+  std::uint64_t gravity_forgotten = 0;       // learnt downs forgotten: a long run of contradictions, or learnt from a replaced wrong lock
   std::uint64_t vision_unchecked = 0;        // re-initialisations refused: tilt not measurable (Unchecked)
   std::uint64_t unaided_down_updates = 0;    // tilt updates from the accelerometer without vision
   std::uint64_t unaided_tilt_contradictions = 0;  // of those, the filter's own tilt contradicted gravity
@@ -121,6 +121,11 @@ class Predictor {
   // The same verdict on an error already measured by tilt_error_rad(t_s, ...) (a caller that
   // reports the error too need not measure it twice); an empty error is no verdict (false).
   bool check_tilt(double t_s, std::optional<double> error_rad);
+  // The tracked poses since lock_since_s were a wrong lock, replaced by `cam_T_obj` exposed at t_s
+  // (a detection explained the image better). A learnt down first learnt since then, which this
+  // pose contradicts, was the lock's, and is forgotten (counted in gravity_forgotten); one learnt
+  // before is kept (the replacing pose's own tilt is then the likelier error). True when forgotten.
+  bool replace_wrong_lock(double t_s, const Eigen::Isometry3d& cam_T_obj, double lock_since_s);
   PredictorStatus status(double now_t_s) const;
   // Forgets the state (not the buffered samples): the next pose initialises again.
   void reset();
@@ -133,6 +138,9 @@ class Predictor {
   // Takes the object's learnt down (and its run of contradictions) from another predictor of the
   // same scene: a restart on a corrected clock keeps what the scene's gravity is.
   void carry_learnt_gravity(const Predictor& from) { gravity_ = from.gravity_; }
+  // ... and goes on counting from its counters (status().counters), so that a run's counts do not
+  // start again at the restart. Samples fed again on the new clock count again in imu_accepted.
+  void carry_counters(const Predictor& from) { status_.counters = from.status_.counters; }
 
   // The newest filter state (ImuAided), for diagnostics and tests; empty before initialisation.
   std::optional<NavState> state() const;
