@@ -32,7 +32,6 @@ class RecheckSchedule {
 
   // A pose found by detection at t_s: provisional from now, first recheck first_recheck_s later.
   void found_at(double t_s) {
-    provisional_since_s_ = t_s;
     provisional_until_s_ = t_s + options_.provisional_s;
     next_s_ = t_s + options_.first_recheck_s;
   }
@@ -45,7 +44,6 @@ class RecheckSchedule {
     const bool doubtful = status == vision::TrackStatus::Degraded || relocked;
     if (doubtful && options_.after_doubt && !(t_s <= provisional_until_s_)) {
       ++after_doubt_;
-      provisional_since_s_ = t_s;
       provisional_until_s_ = t_s + options_.provisional_s;
       next_s_ = t_s;
     }
@@ -54,13 +52,10 @@ class RecheckSchedule {
     return true;
   }
   int started_after_doubt() const { return after_doubt_; }
-  // When the last provisional stretch began: what a recheck finds wrong may have been tracked
-  // since then, not before (the pose was not in doubt).
-  double provisional_since_s() const { return provisional_since_s_; }
 
  private:
   RecheckOptions options_;
-  double provisional_since_s_ = -INFINITY, provisional_until_s_ = -INFINITY, next_s_ = 0;
+  double provisional_until_s_ = -INFINITY, next_s_ = 0;
   int after_doubt_ = 0;
 };
 

@@ -63,6 +63,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   auto r = detect(frame, t_s, std::nullopt);
   if (r && *r) {
     start_frame_ = frame_number;
+    last_doubt_t_s_ = t_s;
     rechecks_due_.found_at(t_s);
     switch_.forget();
   }
@@ -133,7 +134,9 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
                                                                   vision::FrameReport& report) {
   std::optional<Eigen::Isometry3d> found;
   bool switched = false;
-  double lock_since_s = 0;  // with `switched`: since when the replaced pose was in doubt
+  if (report.status != vision::TrackStatus::Tracked || vision::has(report.reasons, vision::TrackReason::Reacquired))
+    last_doubt_t_s_ = t_s;
+  const double lock_since_s = last_doubt_t_s_;  // with `switched`: since when the replaced pose may have been held
   if (after_frame(report.status)) {
     auto again = find_again(frame, t_s, predicted, predictor.upright(t_s));
     if (!again) return std::unexpected(again.error());
@@ -148,7 +151,6 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
     // tracked pose itself).
     if (rechecks_due_.started_after_doubt() != doubt_stretches) orient_ref_ = last_tracked_;
     if (due) {
-      lock_since_s = rechecks_due_.provisional_since_s();
       auto better = recheck(frame, t_s, report.cam_T_obj, orient_ref_ ? *orient_ref_ : report.cam_T_obj);
       if (!better) return std::unexpected(better.error());
       found = *better;
@@ -157,11 +159,13 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   }
   if (report.status == vision::TrackStatus::Tracked) last_tracked_ = found ? *found : report.cam_T_obj;
   if (!found) return {};
+  last_doubt_t_s_ = t_s;
   // A down first learnt while the tracker held the wrong lock this replaces is the lock's: levelled
   // to it, the object's own pose would be tilted off, taken as against gravity and lost, again
   // after each re-acquisition (late_entry development seed 4 with the IMU: a poster's box held for
-  // 50 frames from the start). A down learnt before the doubt began is kept: on stumble's seed 1 a
-  // switch's detected pose was itself tilted more than 10 deg, and levelling put it right.
+  // 50 frames from the start). A down learnt before the lock can have begun is kept: on stumble's
+  // development seed 1 with the IMU a switch's detected pose, after the jolt, was itself tilted
+  // more than 10 deg from a down learnt in the second before it.
   if (switched) predictor.replace_wrong_lock(t_s, *found, lock_since_s);
   // With the IMU and the object's down learnt, the tilt is gravity's, not the outline's.
   if (const auto up = predictor.upright(t_s)) {

@@ -83,6 +83,10 @@ class TrackAcquisition {
   RecheckSwitch switch_;
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
   std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a doubtful frame started
+  // The last time the tracked pose may have changed what it holds: a detection (start,
+  // re-acquisition, switch), or a frame lost, degraded or re-locked. A wrong lock a recheck
+  // replaces was held since then at the earliest.
+  double last_doubt_t_s_ = -INFINITY;
   Eigen::Vector3d centre_obj_;  // vision::model_centre: levelled poses turn about it
   int levelled_ = 0;                                     // found poses levelled to gravity (geometry/level_to_up.h)
   int rechecks_ = 0, switches_ = 0;
