@@ -19,10 +19,10 @@ struct RecheckOptions {
   double recheck_interval_s = 0.5;
   // After a pose found by detection, the first recheck this soon (then every interval).
   double first_recheck_s = 0.1;
-  // Without the IMU, a burst the constant-velocity prediction cannot follow leaves the tracker on
-  // a wrong lock that it then reports as tracked; the degraded frames, or lost frames it then
-  // re-locks from, on the way there are the only sign, and detection the only thing that tells
-  // the lock from the object.
+  // A burst the constant-velocity prediction cannot follow, or with the IMU a jolt, a cover or a
+  // bad first frame, leaves the tracker on a wrong lock that it then reports as tracked; the
+  // degraded frames, or lost frames it then re-locks from, on the way there are the only sign, and
+  // detection the only thing that tells the lock from the object.
   bool after_doubt = true;
 };
 
