@@ -57,15 +57,19 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
   return std::optional<Eigen::Isometry3d>{r->best.cam_T_obj};
 }
 
+void TrackAcquisition::took_detected(double t_s) {
+  rechecks_due_.found_at(t_s);
+  switch_.forget();
+  last_doubt_t_s_ = t_s;
+}
+
 std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::find_start(const cv::Mat& frame, int frame_number,
                                                                                           double t_s) {
   ++start_attempts_;
   auto r = detect(frame, t_s, std::nullopt);
   if (r && *r) {
     start_frame_ = frame_number;
-    last_doubt_t_s_ = t_s;
-    rechecks_due_.found_at(t_s);
-    switch_.forget();
+    took_detected(t_s);
   }
   return r;
 }
@@ -98,8 +102,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   auto r = detect(frame, t_s, near, predicted, upright);
   if (r && *r) {
     ++reacquired_;
-    rechecks_due_.found_at(t_s);
-    switch_.forget();
+    took_detected(t_s);
     orient_ref_.reset();
     frames_to_reacquire_.push_back(lost_run_);
     lost_run_ = 0;
@@ -123,7 +126,7 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
                           {"tracked_support", now->support}, {"tracked_refused", refused != 0}, {"switched", take}});
   if (!take) return std::optional<Eigen::Isometry3d>{};
   ++switches_;
-  rechecks_due_.found_at(t_s);
+  took_detected(t_s);
   orient_ref_.reset();
   return found;
 }
@@ -159,7 +162,6 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   }
   if (report.status == vision::TrackStatus::Tracked) last_tracked_ = found ? *found : report.cam_T_obj;
   if (!found) return {};
-  last_doubt_t_s_ = t_s;
   // A down first learnt while the tracker held the wrong lock this replaces is the lock's: levelled
   // to it, the object's own pose would be tilted off, taken as against gravity and lost, again
   // after each re-acquisition (late_entry development seed 4 with the IMU: a poster's box held for

@@ -71,6 +71,9 @@ class TrackAcquisition {
                                                                       const std::optional<Eigen::Isometry3d>& near,
                                                                       const std::optional<Eigen::Isometry3d>& orient_like = {},
                                                                       const std::optional<Upright>& upright = {});
+  // A pose found by detection (start, re-acquisition, switch) is taken at t_s: provisional from
+  // now, no lead carried over from rechecks of the pose it replaces, and a new lock's beginning.
+  void took_detected(double t_s);
   const vision::Sequence* seq_;
   vision::ModelTrackerOptions tracking_;
   AcquisitionOptions options_;
