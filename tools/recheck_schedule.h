@@ -32,14 +32,22 @@ class RecheckSchedule {
 
   // A pose found by detection at t_s: provisional from now, first recheck first_recheck_s later.
   void found_at(double t_s) {
+    lost_before_ = false;
     provisional_until_s_ = t_s + options_.provisional_s;
     next_s_ = t_s + options_.first_recheck_s;
   }
-  // After the tracker's frame at t_s: whether the search runs on it. A doubtful frame (degraded,
-  // or `relocked`: tracked again from the prediction after lost frames) outside a provisional
-  // stretch starts one, with its first recheck on this frame; a lost frame never rechecks
-  // (re-acquisition handles it).
+  // After the tracker's frame at t_s (every frame, lost ones too): whether the search runs on it.
+  // A doubtful frame (degraded, or re-locked: tracked again from the prediction after lost frames)
+  // outside a provisional stretch starts one, with its first recheck on this frame; a lost frame
+  // never rechecks (re-acquisition handles it). The first frame kept after lost ones counts as
+  // re-locked whatever `relocked` (the tracker's Reacquired) says: when the tracker's re-locked
+  // frame was then taken as lost (against gravity, the image's motion), the next one carries no
+  // such reason (stumble development seed 3 with the IMU: re-locked 6-9 deg off after the jolt and
+  // tracked for 24 frames unrechecked).
   bool due_after(vision::TrackStatus status, double t_s, bool relocked = false) {
+    const bool after_loss = lost_before_;
+    lost_before_ = status == vision::TrackStatus::Lost;
+    relocked = relocked || after_loss;
     if (status == vision::TrackStatus::Lost || !(options_.provisional_s > 0)) return false;
     const bool doubtful = status == vision::TrackStatus::Degraded || relocked;
     if (doubtful && options_.after_doubt && !(t_s <= provisional_until_s_)) {
@@ -56,6 +64,7 @@ class RecheckSchedule {
  private:
   RecheckOptions options_;
   double provisional_until_s_ = -INFINITY, next_s_ = 0;
+  bool lost_before_ = false;  // the last frame was lost
   int after_doubt_ = 0;
 };
 

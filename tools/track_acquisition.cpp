@@ -3,12 +3,20 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "epichead/geometry/level_to_up.h"
 #include "epichead/vision/model_centre.h"
 
 namespace epichead::tools {
 namespace {
+
+// [tx, ty, tz, qw, qx, qy, qz] (m), as in poses.csv.
+nlohmann::json pose_json(const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  const Eigen::Vector3d& t = T.translation();
+  return {t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z()};
+}
 
 // --no-reacquire keeps the detected start's rechecks but starts none of its own after a doubtful frame.
 RecheckOptions recheck_options(const AcquisitionOptions& o) {
@@ -111,19 +119,37 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   return r;
 }
 
-std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::recheck(const cv::Mat& frame, double t_s,
-                                                                                       const Eigen::Isometry3d& tracked,
+std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::recheck(const cv::Mat& frame,
+                                                                                       const vision::WindowImage& image, double t_s,
+                                                                                       const vision::FrameReport& tracked,
                                                                                        const Eigen::Isometry3d& orient_like) {
   ++rechecks_;
   // The whole search; of the poses that draw the same outline, the one turned as orient_like is.
   auto found = detect(frame, t_s, std::nullopt, orient_like);
   if (!found) return found;
-  const auto now = detector_->verify(frame, tracked);
+  const auto now = detector_->verify(frame, tracked.cam_T_obj);
   if (!now) return std::unexpected(now.error());
   const unsigned refused = vision::failed_detection_tests(*now, options_.detection.options) & ~vision::kTooShortOutline;
-  const bool take = switch_.take(t_s, found->has_value(), last_score_, now->score, refused != 0);
-  recheck_log_.push_back({{"t_s", t_s}, {"found", found->has_value()}, {"found_score", last_score_}, {"tracked_score", now->score},
-                          {"tracked_support", now->support}, {"tracked_refused", refused != 0}, {"switched", take}});
+  RecheckEvidence e{.found = found->has_value(), .found_score = last_score_, .tracked_score = now->score,
+                    .tracked_refused = refused != 0, .tracked_lines = tracked.inliers};
+  nlohmann::json log = {{"t_s", t_s}, {"found", e.found}, {"found_score", e.found_score}, {"tracked_score", e.tracked_score},
+                        {"tracked_support", now->support}, {"tracked_refused", e.tracked_refused},
+                        {"tracked_lines", {tracked.inliers, tracked.visible}}, {"tracked_pose", pose_json(tracked.cam_T_obj)}};
+  if (e.found) {
+    // The tracker's own measurement from the found pose, as a switch would take it.
+    if (!trial_) trial_ = std::make_unique<vision::ModelTracker>(seq_->model(), seq_->camera(), tracking_);
+    trial_->reset();
+    trial_->track(image, **found, trial_report_);
+    e.found_lines = trial_report_.inliers;
+    const Eigen::AngleAxisd turn(tracked.cam_T_obj.linear().transpose() * (*found)->linear());
+    log["found_lines"] = {trial_report_.inliers, trial_report_.visible};
+    log["found_status"] = vision::to_string(trial_report_.status);
+    log["found_pose"] = pose_json(**found);
+    log["turn_deg"] = turn.angle() * 180 / std::numbers::pi;
+  }
+  const bool take = switch_.take(t_s, e);
+  log["switched"] = take;
+  recheck_log_.push_back(std::move(log));
   if (!take) return std::optional<Eigen::Isometry3d>{};
   ++switches_;
   took_detected(t_s);
@@ -137,16 +163,17 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
                                                                   vision::FrameReport& report) {
   std::optional<Eigen::Isometry3d> found;
   bool switched = false;
-  if (report.status != vision::TrackStatus::Tracked || vision::has(report.reasons, vision::TrackReason::Reacquired))
-    last_doubt_t_s_ = t_s;
+  // A lost frame is a doubtful one too, so the frame kept after it needs no mark of its own here.
+  const bool relocked = vision::has(report.reasons, vision::TrackReason::Reacquired);
+  if (report.status != vision::TrackStatus::Tracked || relocked) last_doubt_t_s_ = t_s;
   const double lock_since_s = last_doubt_t_s_;  // with `switched`: since when the replaced pose may have been held
+  const int doubt_stretches = rechecks_due_.started_after_doubt();
+  const bool due = rechecks_due_.due_after(report.status, t_s, relocked);  // never on a lost frame
   if (after_frame(report.status)) {
     auto again = find_again(frame, t_s, predicted, predictor.upright(t_s));
     if (!again) return std::unexpected(again.error());
     found = *again;
   } else {
-    const int doubt_stretches = rechecks_due_.started_after_doubt();
-    const bool due = rechecks_due_.due_after(report.status, t_s, vision::has(report.reasons, vision::TrackReason::Reacquired));
     // A stretch a doubtful frame started (degraded, or re-locked from the prediction after a
     // loss: Reacquired without a detection): the tracked pose may be a wrong lock turned well away,
     // and of a symmetric model's outlines the one nearest it may be a twin of the object's. The
@@ -154,7 +181,7 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
     // tracked pose itself).
     if (rechecks_due_.started_after_doubt() != doubt_stretches) orient_ref_ = last_tracked_;
     if (due) {
-      auto better = recheck(frame, t_s, report.cam_T_obj, orient_ref_ ? *orient_ref_ : report.cam_T_obj);
+      auto better = recheck(frame, image, t_s, report, orient_ref_ ? *orient_ref_ : report.cam_T_obj);
       if (!better) return std::unexpected(better.error());
       found = *better;
       switched = found.has_value();

@@ -59,10 +59,10 @@ class TrackAcquisition {
                                                   const Eigen::Isometry3d& predicted, vision::ModelTracker& tracker,
                                                   TrackPredictor& predictor, vision::FrameReport& report);
   // A recheck (the schedule said so): the whole search on this frame, and the pose to switch to
-  // when it explains a much longer outline than `tracked`.
+  // when it explains a much longer outline than `tracked` (this frame's tracking).
   // Of the poses that draw the same outline, the one turned as `orient_like` is taken.
-  std::expected<std::optional<Eigen::Isometry3d>, std::string> recheck(const cv::Mat& frame, double t_s,
-                                                                       const Eigen::Isometry3d& tracked,
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> recheck(const cv::Mat& frame, const vision::WindowImage& image,
+                                                                       double t_s, const vision::FrameReport& tracked,
                                                                        const Eigen::Isometry3d& orient_like);
   nlohmann::json to_json() const;
 
@@ -79,6 +79,9 @@ class TrackAcquisition {
   AcquisitionOptions options_;
   std::optional<Eigen::Vector3d> up_obj_;
   std::unique_ptr<vision::Detector> detector_;
+  // A recheck's found pose measured by the tracker, as a switch would take it (built on first need).
+  std::unique_ptr<vision::ModelTracker> trial_;
+  vision::FrameReport trial_report_;
   int start_frame_ = -1, start_attempts_ = 0;
   int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
   bool in_loss_ = false;

@@ -66,6 +66,25 @@ TEST_CASE("recheck schedule: a frame tracked again after a loss, from the predic
   CHECK_FALSE(none.due_after(TrackStatus::Tracked, 1.2, true));
 }
 
+TEST_CASE("recheck schedule: the first frame kept after lost ones is a re-lock, whatever the tracker says") {
+  // The tracker's re-locked frame was taken as lost (against gravity): the next one is the first
+  // kept and carries no Reacquired (stumble development seed 3 with the IMU).
+  RecheckSchedule s;
+  CHECK_FALSE(s.due_after(TrackStatus::Tracked, 1.0));
+  CHECK_FALSE(s.due_after(TrackStatus::Lost, 1.1));
+  CHECK_FALSE(s.due_after(TrackStatus::Lost, 1.2));
+  CHECK(s.due_after(TrackStatus::Tracked, 1.3));
+  CHECK(s.started_after_doubt() == 1);
+  CHECK_FALSE(s.due_after(TrackStatus::Tracked, 1.4));
+  // A pose found by detection during the loss is provisional already: no stretch of its own.
+  RecheckSchedule d;
+  CHECK_FALSE(d.due_after(TrackStatus::Lost, 1.0));
+  d.found_at(1.05);
+  CHECK_FALSE(d.due_after(TrackStatus::Tracked, 1.1));
+  CHECK(d.due_after(TrackStatus::Tracked, 1.16));  // the found pose's first recheck
+  CHECK(d.started_after_doubt() == 0);
+}
+
 TEST_CASE("recheck schedule: off after doubtful frames, or with no provisional time, nothing is due") {
   RecheckOptions no_doubt;
   no_doubt.after_doubt = false;
