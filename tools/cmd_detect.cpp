@@ -18,6 +18,7 @@
 
 #include "command.h"
 #include "detection_setup.h"
+#include "pose_json.h"
 #include "epichead/vision/cao_model.h"
 #include "epichead/vision/offline/overlay.h"
 #include "epichead/vision/offline/sequence.h"
@@ -35,11 +36,6 @@ struct DetectArgs {
   bool every_hypothesis = false;
   DetectionArgs detection;
 };
-
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.linear());
-  return {{"t_m", {T.translation().x(), T.translation().y(), T.translation().z()}}, {"q_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
-}
 
 // Rotation (deg) and translation (mm) between a pose and the ground truth of its frame.
 std::optional<std::pair<double, double>> error_to_truth(const Sequence& seq, int frame, const Eigen::Isometry3d& T) {

@@ -5,18 +5,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "pose_json.h"
 #include "epichead/geometry/level_to_up.h"
 #include "epichead/vision/model_centre.h"
 
 namespace epichead::tools {
 namespace {
-
-// [tx, ty, tz, qw, qx, qy, qz] (m), as in poses.csv.
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.linear());
-  const Eigen::Vector3d& t = T.translation();
-  return {t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z()};
-}
 
 // --no-reacquire keeps the detected start's rechecks but starts none of its own after a doubtful frame.
 RecheckOptions recheck_options(const AcquisitionOptions& o) {
@@ -136,7 +130,8 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
                         {"tracked_support", now->support}, {"tracked_refused", e.tracked_refused},
                         {"tracked_lines", {tracked.inliers, tracked.visible}}, {"tracked_pose", pose_json(tracked.cam_T_obj)}};
   if (e.found) {
-    // The tracker's own measurement from the found pose, as a switch would take it.
+    // The tracker's own measurement from the found pose, as a switch would take it (before the
+    // switch levels it to gravity).
     if (!trial_) trial_ = std::make_unique<vision::ModelTracker>(seq_->model(), seq_->camera(), tracking_);
     trial_->reset();
     trial_->track(image, **found, trial_report_);

@@ -268,7 +268,19 @@ TEST_CASE("track by constant velocity alone (--image-motion off) rechecks a pose
   CHECK(acq["recheck_stretches_after_doubt"].get<int>() >= 1);
   CHECK(acq["switches"].get<int>() >= 1);
   int switched = 0;  // the log says which rechecks switched
-  for (const auto& r : acq["recheck_log"]) switched += r.at("switched").get<bool>() ? 1 : 0;
+  for (const auto& r : acq["recheck_log"]) {
+    switched += r.at("switched").get<bool>() ? 1 : 0;
+    // Each recheck gives the tracked pose and the lines kept at it (kept, visible); one that
+    // found a pose gives that pose and the lines the tracker kept measuring from it. A switch
+    // never took a pose at which it kept under half the tracked pose's lines.
+    CHECK(r.at("tracked_pose").at("q_wxyz").size() == 4);
+    CHECK(r.at("tracked_lines").size() == 2);
+    if (!r.at("found").get<bool>()) continue;
+    CHECK(r.at("found_pose").at("t_m").size() == 3);
+    const int found_kept = r.at("found_lines")[0].get<int>(), found_visible = r.at("found_lines")[1].get<int>();
+    CHECK(found_kept <= found_visible);
+    if (r.at("switched").get<bool>()) CHECK(2 * found_kept >= r.at("tracked_lines")[0].get<int>());
+  }
   CHECK(switched == acq["switches"].get<int>());
   const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --per-frame " +
                                            q(tmp / "per_frame.csv") + " --json");
