@@ -45,8 +45,8 @@ struct RecheckEvidence {
   double found_score = 0;      // the detector's verification: support x supported outline
   double tracked_score = 0;
   bool tracked_refused = false;  // the tracked pose fails a test that says it is wrong
-  // Model lines the tracker's pose kept (inliers): measured from the found pose, and this frame's
-  // tracking.
+  // Model lines the tracker's pose kept (inliers; straight edges, circles not counted): measured
+  // from the found pose, and this frame's tracking.
   int found_lines = 0, tracked_lines = 0;
 };
 
