@@ -42,6 +42,13 @@ TEST_CASE("track follows a short simulated mockup_walk with epic+validation and 
   // without IMU prediction (it is then reported lost, and re-acquired on the next frame).
   CHECK(report["lost"].get<int>() <= 1);
   CHECK(report["track_ms_median"].get<double>() > 0);
+  // The worst frame beside the median and p99 (a start, or preemption; docs/performance.md), and
+  // it is the largest of the frames' own times.
+  CHECK(report["track_ms_p99"].get<double>() >= report["track_ms_median"].get<double>());
+  CHECK(report["track_ms_max"].get<double>() >= report["track_ms_p99"].get<double>());
+  double worst = 0;
+  for (const auto& f : report["per_frame"]) worst = std::max(worst, f["ms"]["total"].get<double>());
+  CHECK(report["track_ms_max"].get<double>() == worst);
   CHECK(report["per_frame"].size() == 40);
   CHECK(report["per_frame"][5]["lines"]["visible"].get<int>() >= 25);
   CHECK(fs::exists(out + "/overlay_000000.png"));
