@@ -6,8 +6,10 @@
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
+#include "epichead/geometry/se3.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
+#include "gated_agreement.h"
 
 namespace epichead::tools {
 namespace {
@@ -121,8 +123,8 @@ class ImuPredictor final : public TrackPredictor {
   ImuPredictor(const fusion::PredictorOptions& options, fusion::Predictor predictor, const vision::Sequence& seq,
                std::optional<fusion::TimeOffsetEstimator> estimator)
       : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
-        last_good_(seq.init().cam_T_obj), vision_only_(seq.init().t_s, seq.init().cam_T_obj),
-        estimator_(std::move(estimator)) {
+        last_good_(seq.init().cam_T_obj), gated_(GatedAgreementOptions{.chi2 = options.gate_chi2}),
+        vision_only_(seq.init().t_s, seq.init().cam_T_obj), estimator_(std::move(estimator)) {
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
     init_t_s_ = seq.init().t_s;
@@ -149,6 +151,7 @@ class ImuPredictor final : public TrackPredictor {
     pending_init_ = true;
     reset_done_ = false;
     supported_gated_ = 0;
+    gated_.clear();
     last_applied_t_s_ = -INFINITY;  // a detected pose is not a tracked one
     ++detection_restarts_;
   }
@@ -158,6 +161,7 @@ class ImuPredictor final : public TrackPredictor {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
         predictor_.reset();
+        gated_.clear();
         last_applied_t_s_ = -INFINITY;
         reset_done_ = true;
         ++resets_;
@@ -189,20 +193,29 @@ class ImuPredictor final : public TrackPredictor {
     // ~0.3 m/s: the translation ran off 26 mm per frame (office_pan, development seed 3).
     if (seeded_by_init_ && t_s <= init_t_s_) predictor_.reset();
     seeded_by_init_ = false;
+    const std::optional<fusion::PosePrediction> before = predictor_.predict(t_s);
     auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
     // Vision and the filter disagree: which is wrong? A pose found only from the vision-only
     // extrapolation says the IMU's prediction had left the object; a run of gated poses that
-    // the image supports well (tracked, not degraded) says the filter has drifted. Either way
-    // the filter restarts from vision now instead of after reinit_after_gated frames.
+    // the image supports well (tracked, not degraded) says the filter has drifted; so do gated
+    // poses that agree with each other, applied ones between them or not (gated_agreement.h).
+    // Each way the filter restarts from vision now instead of after reinit_after_gated frames,
+    // keeping the camera's motion the IMU measured (Predictor::restart_keeping_motion).
     const bool strong = strongly_supported(report);
     if (r.verdict == fusion::VisionVerdict::Gated && strong) ++supported_gated_;
     else supported_gated_ = 0;
-    if ((report.used_fallback && strong) || supported_gated_ >= kSupportedGatedRestart) {
-      predictor_.reset();
-      r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
+    const bool agreeing = r.verdict == fusion::VisionVerdict::Gated && before &&
+                          gated_.add(t_s, geometry::se3_log(report.cam_T_obj * before->cam_T_obj.inverse()), report.covariance);
+    int* restarts = report.used_fallback && strong                ? &fallback_restarts_
+                    : supported_gated_ >= kSupportedGatedRestart ? &gated_restarts_
+                    : agreeing                                   ? &agreeing_restarts_
+                                                                 : nullptr;
+    if (restarts) {
+      r = predictor_.restart_keeping_motion(t_s, report.cam_T_obj, report.covariance);
       supported_gated_ = 0;
-      ++(report.used_fallback ? fallback_restarts_ : gated_restarts_);
+      gated_.clear();
+      ++*restarts;
     }
     // A tracked pose supersedes the init pose as the filter's seed, whether it started the
     // filter or could not yet (no IMU sample before it, or too old).
@@ -273,6 +286,7 @@ class ImuPredictor final : public TrackPredictor {
             {"restarts_from_fallback", fallback_restarts_},
             {"weak_poses_after_loss", weak_reacquisitions_},
             {"restarts_after_supported_gated", gated_restarts_},
+            {"restarts_after_agreeing_gated", agreeing_restarts_},
             {"restarts_from_detection", detection_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},
@@ -354,6 +368,8 @@ class ImuPredictor final : public TrackPredictor {
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
   int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0, detection_restarts_ = 0;
+  int agreeing_restarts_ = 0;
+  GatedAgreement gated_;
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).

@@ -431,6 +431,26 @@ void Predictor::reset() {
   status_.gated_in_a_row = 0;
 }
 
+VisionResult Predictor::restart_keeping_motion(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
+  const std::optional<PosePrediction> before = predict(t_s);
+  const StateEntry* e = imu_.newest_state();
+  if (before && e && cam_T_obj.matrix().allFinite()) {
+    // The filter's object frame into the pose's: obj_new_R_obj_old = obj_new_R_cam * cam_R_obj_old.
+    const Eigen::Matrix3d turn = cam_T_obj.linear().transpose() * before->cam_T_obj.linear();
+    NavState motion = e->x;
+    motion.obj_v_cam = turn * motion.obj_v_cam;
+    motion.obj_R_grav = turn * motion.obj_R_grav;  // its error is local to the gravity frame: unchanged
+    ErrorCovariance P = e->P;
+    P.middleRows<3>(err::v) = turn * P.middleRows<3>(err::v);
+    P.middleCols<3>(err::v) = P.middleCols<3>(err::v) * turn.transpose();
+    imu_.carry_motion(motion, P);
+  }
+  reset();
+  const VisionResult r = add_vision(t_s, cam_T_obj, cov);
+  if (r.verdict != VisionVerdict::Initialised) imu_.drop_carried_motion();
+  return r;
+}
+
 std::optional<NavState> Predictor::state() const {
   const StateEntry* e = imu_.newest_state();
   if (!e) return std::nullopt;

@@ -1,6 +1,7 @@
 // Bad input and faults: every bad IMU sample is rejected and counted without touching the state,
 // dropouts are reported and grow the covariance, gross vision outliers are gated, a run of gated
-// poses or reset() leads to re-initialisation, bad vision input and bad options are refused.
+// poses or reset() leads to re-initialisation (a restart from a pose that overrules the filter keeps
+// the motion), bad vision input and bad options are refused.
 #include <catch2/catch.hpp>
 
 #include <limits>
@@ -252,4 +253,38 @@ TEST_CASE("a pose stamped more than buffer_s after the newest sample is refused 
         VisionVerdict::BadInput);
   CHECK(p.add_vision(1e12, r.traj.at(0.45).x.cam_T_obj(), pose_cov(3e-3, 4e-3)).verdict == VisionVerdict::BadInput);
   CHECK(p.add_imu(r.imu.samples[r.next++]) == ImuVerdict::Accepted);
+}
+
+TEST_CASE("a restart keeping the motion takes the pose and keeps the camera's velocity and gravity as the IMU measured them") {
+  // The caller decided the filter's object frame was off by 8 deg (the pose it restarts from is
+  // turned so): the camera's velocity and the gravity direction, in the camera frame where the IMU
+  // measures them, carry over, re-expressed in the new object frame; a plain reset starts the
+  // velocity at zero with the default 0.5 m/s 1-sigma.
+  const Eigen::Isometry3d turned_obj(Eigen::AngleAxisd(8 * kDegRad, Eigen::Vector3d(1, 0.3, 0).normalized()));
+  const double t = 0.5;  // the newest sample's time: the carried motion is the newest state's
+  Running r;
+  Predictor& p = r.predictor;
+  REQUIRE(p.state());
+  const NavState old = *p.state();
+  const Eigen::Matrix3d old_cam_R_obj = old.obj_R_cam.transpose();
+  const Eigen::Isometry3d pose = r.traj.at(t).x.cam_T_obj() * turned_obj;
+  const VisionResult re = p.restart_keeping_motion(t, pose, pose_cov(1e-3, 1e-3));
+  CHECK(re.verdict == VisionVerdict::Initialised);
+  REQUIRE(p.state());
+  const NavState now = *p.state();
+  CHECK((now.cam_T_obj().matrix() - pose.matrix()).norm() < 1e-9);
+  const Eigen::Matrix3d cam_R_obj = now.obj_R_cam.transpose();
+  CHECK(old.obj_v_cam.norm() > 0.05);  // the trajectory moves
+  CHECK((cam_R_obj * now.obj_v_cam - old_cam_R_obj * old.obj_v_cam).norm() < 1e-9);
+  CHECK((cam_R_obj * now.gravity_obj_mps2() - old_cam_R_obj * old.gravity_obj_mps2()).norm() < 1e-9);
+  CHECK(now.gyro_bias_radps == old.gyro_bias_radps);
+  CHECK(now.accel_bias_mps2 == old.accel_bias_mps2);
+  const double velocity_sigma = std::sqrt(p.covariance().diagonal().segment<3>(err::v).maxCoeff());
+  CHECK(velocity_sigma < 0.1);
+
+  Running plain;
+  plain.predictor.reset();
+  CHECK(plain.predictor.add_vision(t, pose, pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Initialised);
+  CHECK(plain.predictor.state()->obj_v_cam.norm() == 0);
+  CHECK(std::sqrt(plain.predictor.covariance()(err::v, err::v)) == Approx(0.5));
 }

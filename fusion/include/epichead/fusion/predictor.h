@@ -129,6 +129,14 @@ class Predictor {
   PredictorStatus status(double now_t_s) const;
   // Forgets the state (not the buffered samples): the next pose initialises again.
   void reset();
+  // Starts again from a vision pose that overrules the filter's (the caller decided the filter was
+  // off, vision right), keeping what the IMU measured of the camera's motion: velocity, biases and
+  // gravity, turned from the filter's object frame into the pose's (in the camera frame, where
+  // the IMU measures them, they stay). The pose is checked as a first pose is (check_tilt).
+  // A restart from defaults starts the velocity at zero and gravity from the accelerometer's mean:
+  // in a hand-held motion the translation then ran off 10-15 mm a frame (development lampshade 5,
+  // tools/track_prediction.cpp's restarts; docs/fusion.md, "Gated poses that agree").
+  VisionResult restart_keeping_motion(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
   // The next initialisation takes velocity, biases and gravity direction (and their variances)
   // from `motion` instead of the defaults: for a restart on a corrected clock (the camera-IMU
   // time offset just estimated) while the motion state learnt so far still holds. A restart from
