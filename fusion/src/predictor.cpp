@@ -435,7 +435,9 @@ VisionResult Predictor::restart_keeping_motion(double t_s, const Eigen::Isometry
   const std::optional<PosePrediction> before = predict(t_s);
   const StateEntry* e = imu_.newest_state();
   if (before && e && cam_T_obj.matrix().allFinite()) {
-    // The filter's object frame into the pose's: obj_new_R_obj_old = obj_new_R_cam * cam_R_obj_old.
+    // The newest state's motion: callers feed the IMU up to the exposure first, so it is at most a
+    // sample later. The filter's object frame into the pose's: obj_new_R_obj_old = obj_new_R_cam *
+    // cam_R_obj_old, the same at any instant when the filter's error is a fixed turn of the object.
     const Eigen::Matrix3d turn = cam_T_obj.linear().transpose() * before->cam_T_obj.linear();
     NavState motion = e->x;
     motion.obj_v_cam = turn * motion.obj_v_cam;
