@@ -474,6 +474,7 @@ int run_track(const TrackArgs& args) {
     per_frame.back()["image_share"] = static_cast<double>(image.tiles_prepared()) / image.tiles();
     if (use_image_motion) per_frame.back()["image_motion"] = image_motion.frame_json();
     if (tilt_error_rad) per_frame.back()["tilt_error_deg"] = *tilt_error_rad * 180 / std::numbers::pi;
+    if (auto filter = (*predictor)->frame_verdict(); !filter.is_null()) per_frame.back()["filter"] = std::move(filter);
 
     write_selected_lines(lines_csv, tracker, report, entry.frame, selected);
 

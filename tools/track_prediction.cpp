@@ -157,6 +157,7 @@ class ImuPredictor final : public TrackPredictor {
   }
   void observe(double t_s, const vision::FrameReport& report) override {
     vision_only_.observe(t_s, report);
+    verdict_ = nullptr;
     if (report.status == vision::TrackStatus::Lost) {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
@@ -176,6 +177,7 @@ class ImuPredictor final : public TrackPredictor {
       // started on it holds the windows there (can, after its 1 s cover: 14 deg off for good).
       // Meanwhile the windows follow the vision poses (predict() falls back to last_good_).
       ++weak_reacquisitions_;
+      verdict_ = {{"verdict", "held-weak-after-loss"}, {"nis", nullptr}, {"restart", nullptr}};
       return;
     }
     reset_done_ = false;
@@ -184,7 +186,11 @@ class ImuPredictor final : public TrackPredictor {
       // A fit costs about a millisecond: try a few times a second, not every frame.
       if (++frames_since_fit_ >= kFitEveryFrames) {
         frames_since_fit_ = 0;
-        if (const auto e = estimator_->estimate()) return adopt(*e, t_s, report);
+        if (const auto e = estimator_->estimate()) {
+          adopt(*e, t_s, report);
+          verdict_ = {{"verdict", "initialised"}, {"nis", nullptr}, {"restart", "clock-offset-estimated"}};
+          return;
+        }
       }
     }
     // The first tracked pose at the start pose's own time replaces it as the seed: applied
@@ -211,11 +217,19 @@ class ImuPredictor final : public TrackPredictor {
                     : supported_gated_ >= kSupportedGatedRestart ? &gated_restarts_
                     : agreeing                                   ? &agreeing_restarts_
                                                                  : nullptr;
+    const bool measured = r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated;
+    verdict_ = {{"verdict", fusion::to_string(r.verdict)},
+                {"nis", measured ? nlohmann::json(r.mahalanobis2) : nlohmann::json(nullptr)},
+                {"restart", restarts == &fallback_restarts_ ? nlohmann::json("fallback")
+                            : restarts == &gated_restarts_  ? nlohmann::json("supported-gated")
+                            : restarts                      ? nlohmann::json("agreeing-gated")
+                                                            : nlohmann::json(nullptr)}};
     if (restarts) {
       r = predictor_.restart_keeping_motion(t_s, report.cam_T_obj, report.covariance);
       supported_gated_ = 0;
       gated_.clear();
       ++*restarts;
+      verdict_["after_restart"] = fusion::to_string(r.verdict);
     }
     // A tracked pose supersedes the init pose as the filter's seed, whether it started the
     // filter or could not yet (no IMU sample before it, or too old).
@@ -250,6 +264,7 @@ class ImuPredictor final : public TrackPredictor {
     if (!down_cam || !down_obj) return std::nullopt;
     return Upright{-*down_cam, -*down_obj, options_.gravity_check.max_tilt_error_rad};
   }
+  nlohmann::json frame_verdict() const override { return verdict_; }
   nlohmann::json diagnostics() const override {
     const auto st = predictor_.status(last_good_t_s_);
     const auto& c = st.counters;
@@ -370,6 +385,7 @@ class ImuPredictor final : public TrackPredictor {
   int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0, detection_restarts_ = 0;
   int agreeing_restarts_ = 0;
   GatedAgreement gated_;
+  nlohmann::json verdict_;  // frame_verdict()
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).

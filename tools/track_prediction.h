@@ -75,6 +75,9 @@ class TrackPredictor {
   // Detection found the object again at t_s (after a loss): predictions restart from this pose
   // at rest, as from init.csv.
   virtual void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) = 0;
+  // After observe(t_s): what the filter did with that frame's pose, for report.json's per_frame
+  // ({"verdict", "nis", "restart"}); null when there is no filter or it was not given the pose.
+  virtual nlohmann::json frame_verdict() const { return nullptr; }
   // Counters for report.json.
   virtual nlohmann::json diagnostics() const = 0;
 };

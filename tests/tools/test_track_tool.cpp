@@ -156,6 +156,27 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   REQUIRE(tilts.size() >= 20);
   std::nth_element(tilts.begin(), tilts.begin() + tilts.size() / 2, tilts.end());
   CHECK(tilts[tilts.size() / 2] < 1.0);
+  // Each frame the filter was given says what it did; the counts agree with the predictor's.
+  int applied = 0, gated = 0, restarts = 0, given = 0;
+  for (const auto& f : report["per_frame"]) {
+    if (!f.contains("filter")) {
+      CHECK(f["status"] == "lost");
+      continue;
+    }
+    ++given;
+    const auto& v = f["filter"];
+    applied += v["verdict"] == "applied";
+    gated += v["verdict"] == "gated";
+    restarts += !v["restart"].is_null();
+    if (v["verdict"] == "applied" || v["verdict"] == "gated") CHECK(v["nis"].get<double>() >= 0);
+  }
+  const auto& p = report["predictor"];
+  CHECK(given == 75 - report["lost"].get<int>());
+  CHECK(applied == p["vision_applied"].get<int>());
+  CHECK(gated <= p["vision_gated"].get<int>());
+  CHECK(restarts == p["restarts_from_fallback"].get<int>() + p["restarts_after_supported_gated"].get<int>() +
+                        p["restarts_after_agreeing_gated"].get<int>());
+  CHECK(applied > 50);
 }
 
 TEST_CASE("track without the IMU follows a hand-held burst by the frame's own motion, which constant velocity misses") {
