@@ -187,8 +187,8 @@ class ImuPredictor final : public TrackPredictor {
       if (++frames_since_fit_ >= kFitEveryFrames) {
         frames_since_fit_ = 0;
         if (const auto e = estimator_->estimate()) {
-          adopt(*e, t_s, report);
-          verdict_ = {{"verdict", "initialised"}, {"nis", nullptr}, {"restart", "clock-offset-estimated"}};
+          const fusion::VisionResult adopted = adopt(*e, t_s, report);
+          verdict_ = {{"verdict", fusion::to_string(adopted.verdict)}, {"nis", nullptr}, {"restart", "clock-offset-estimated"}};
           return;
         }
       }
@@ -347,7 +347,8 @@ class ImuPredictor final : public TrackPredictor {
   }
   // Restart the filter on the estimated offset from this frame's pose: samples from just
   // before it are fed again on the new clock mapping.
-  void adopt(const fusion::TimeOffsetEstimate& e, double t_s, const vision::FrameReport& report) {
+  // Returns the frame's pose's verdict on the new filter.
+  fusion::VisionResult adopt(const fusion::TimeOffsetEstimate& e, double t_s, const vision::FrameReport& report) {
     adopted_ = true;
     adopted_fit_ = e;
     adopted_at_s_ = t_s;
@@ -356,7 +357,7 @@ class ImuPredictor final : public TrackPredictor {
     o.imu_time_offset_s = offset_s_;
     o.imu_time_offset_sigma_s = kEstimatedOffsetSigmaS;
     auto p = fusion::Predictor::create(o);
-    if (!p) return;  // options were valid once; only the offset changed
+    if (!p) return {};  // options were valid once; only the offset changed (BadInput)
     // The velocity, biases and gravity learnt so far carry over; only the clock changes.
     if (const auto motion = predictor_.state()) p->carry_motion(*motion, predictor_.covariance());
     p->carry_learnt_gravity(predictor_);
@@ -370,6 +371,7 @@ class ImuPredictor final : public TrackPredictor {
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
     if (!pending_init_) last_applied_t_s_ = t_s;
     init_t_s_ = t_s;
+    return r;
   }
   fusion::PredictorOptions options_;
   fusion::Predictor predictor_;
