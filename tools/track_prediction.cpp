@@ -6,10 +6,9 @@
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
-#include "epichead/geometry/se3.h"
+#include "epichead/fusion/vision_arbiter.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
-#include "gated_agreement.h"
 
 namespace epichead::tools {
 namespace {
@@ -123,7 +122,7 @@ class ImuPredictor final : public TrackPredictor {
   ImuPredictor(const fusion::PredictorOptions& options, fusion::Predictor predictor, const vision::Sequence& seq,
                std::optional<fusion::TimeOffsetEstimator> estimator)
       : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
-        last_good_(seq.init().cam_T_obj), gated_(GatedAgreementOptions{.chi2 = options.gate_chi2}),
+        last_good_(seq.init().cam_T_obj), arbiter_(options.gate_chi2),
         vision_only_(seq.init().t_s, seq.init().cam_T_obj), estimator_(std::move(estimator)) {
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
@@ -150,8 +149,7 @@ class ImuPredictor final : public TrackPredictor {
     last_good_t_s_ = init_t_s_ = t_s;
     pending_init_ = true;
     reset_done_ = false;
-    supported_gated_ = 0;
-    gated_.clear();
+    arbiter_.clear();
     last_applied_t_s_ = -INFINITY;  // a detected pose is not a tracked one
     ++detection_restarts_;
   }
@@ -162,7 +160,7 @@ class ImuPredictor final : public TrackPredictor {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
         predictor_.reset();
-        gated_.clear();
+        arbiter_.clear();
         last_applied_t_s_ = -INFINITY;
         reset_done_ = true;
         ++resets_;
@@ -171,7 +169,7 @@ class ImuPredictor final : public TrackPredictor {
     }
     last_good_ = report.cam_T_obj;
     last_good_t_s_ = t_s;
-    if (reset_done_ && !strongly_supported(report)) {
+    if (reset_done_ && !vision::strongly_supported(report)) {
       // Found again after a long loss: the filter restarts only from a pose the image fully
       // supports. One re-found from a stale prediction can be a wrong lock, and a filter
       // started on it holds the windows there (can, after its 1 s cover: 14 deg off for good).
@@ -199,38 +197,20 @@ class ImuPredictor final : public TrackPredictor {
     // ~0.3 m/s: the translation ran off 26 mm per frame (office_pan, development seed 3).
     if (seeded_by_init_ && t_s <= init_t_s_) predictor_.reset();
     seeded_by_init_ = false;
-    const std::optional<fusion::PosePrediction> before = predictor_.predict(t_s);
-    auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
-    if (r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated) nis_.add(r.mahalanobis2);
-    // Vision and the filter disagree: which is wrong? A pose found only from the vision-only
-    // extrapolation says the IMU's prediction had left the object; a run of gated poses that
-    // the image supports well (tracked, not degraded) says the filter has drifted; so do gated
-    // poses that agree with each other, applied ones between them or not (gated_agreement.h).
-    // Each way the filter restarts from vision now instead of after reinit_after_gated frames,
-    // keeping the camera's motion the IMU measured (Predictor::restart_keeping_motion).
-    const bool strong = strongly_supported(report);
-    if (r.verdict == fusion::VisionVerdict::Gated && strong) ++supported_gated_;
-    else supported_gated_ = 0;
-    const bool agreeing = r.verdict == fusion::VisionVerdict::Gated && before &&
-                          gated_.add(t_s, geometry::se3_log(report.cam_T_obj * before->cam_T_obj.inverse()), report.covariance);
-    int* restarts = report.used_fallback && strong                ? &fallback_restarts_
-                    : supported_gated_ >= kSupportedGatedRestart ? &gated_restarts_
-                    : agreeing                                   ? &agreeing_restarts_
-                                                                 : nullptr;
-    const bool measured = r.verdict == fusion::VisionVerdict::Applied || r.verdict == fusion::VisionVerdict::Gated;
-    verdict_ = {{"verdict", fusion::to_string(r.verdict)},
-                {"nis", measured ? nlohmann::json(r.mahalanobis2) : nlohmann::json(nullptr)},
-                {"restart", restarts == &fallback_restarts_ ? nlohmann::json("fallback")
-                            : restarts == &gated_restarts_  ? nlohmann::json("supported-gated")
-                            : restarts                      ? nlohmann::json("agreeing-gated")
-                                                            : nlohmann::json(nullptr)}};
-    if (restarts) {
-      r = predictor_.restart_keeping_motion(t_s, report.cam_T_obj, report.covariance);
-      supported_gated_ = 0;
-      gated_.clear();
-      ++*restarts;
-      verdict_["after_restart"] = fusion::to_string(r.verdict);
-    }
+    // Vision and the filter disagree: which is wrong? The arbiter restarts the filter from a
+    // pose the image supports well when it was found from the vision-only extrapolation, after
+    // three such poses gated in a row, or when gated poses agree (fusion/vision_arbiter.h).
+    const fusion::PoseSupport support{vision::strongly_supported(report), report.used_fallback};
+    const fusion::ArbitratedVision a = arbiter_.add_vision(predictor_, t_s, report.cam_T_obj, report.covariance, support);
+    const fusion::VisionVerdict first = a.result.verdict;
+    const bool measured = first == fusion::VisionVerdict::Applied || first == fusion::VisionVerdict::Gated;
+    if (measured) nis_.add(a.result.mahalanobis2);
+    const char* restart = fusion::to_string(a.restart);
+    verdict_ = {{"verdict", fusion::to_string(first)},
+                {"nis", measured ? nlohmann::json(a.result.mahalanobis2) : nlohmann::json(nullptr)},
+                {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)}};
+    if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
+    const fusion::VisionResult& r = a.final();
     // A tracked pose supersedes the init pose as the filter's seed, whether it started the
     // filter or could not yet (no IMU sample before it, or too old).
     if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld ||
@@ -298,10 +278,10 @@ class ImuPredictor final : public TrackPredictor {
             {"vision_against_gravity", c.vision_against_gravity},
             {"gravity_forgotten", c.gravity_forgotten},
             {"resets_after_loss", resets_},
-            {"restarts_from_fallback", fallback_restarts_},
+            {"restarts_from_fallback", arbiter_.counters().fallback},
             {"weak_poses_after_loss", weak_reacquisitions_},
-            {"restarts_after_supported_gated", gated_restarts_},
-            {"restarts_after_agreeing_gated", agreeing_restarts_},
+            {"restarts_after_supported_gated", arbiter_.counters().supported_gated},
+            {"restarts_after_agreeing_gated", arbiter_.counters().agreeing_gated},
             {"restarts_from_detection", detection_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},
@@ -309,15 +289,6 @@ class ImuPredictor final : public TrackPredictor {
   }
 
  private:
-  using Matrix6 = Eigen::Matrix<double, 6, 6>;
-  // A pose the image supports well enough to overrule the filter: tracked (no reasons), at
-  // least 80 % of the found features kept, and six constraints or more (a line counts one, an
-  // ellipse two). On box_clutter a wrong pose from 4 of 7 lines was "tracked"; taking it over
-  // the filter's prediction lost the object for good.
-  static bool strongly_supported(const vision::FrameReport& r) {
-    const int found = r.found + 2 * r.ellipses_found, kept = r.inliers + 2 * r.ellipses_found;
-    return r.status == vision::TrackStatus::Tracked && kept >= 6 && kept >= 0.8 * found;
-  }
   // The object's down the predictor learnt (unit, object frame), or null.
   nlohmann::json learnt_down_json() const {
     const auto d = predictor_.learnt_down_obj();
@@ -325,7 +296,6 @@ class ImuPredictor final : public TrackPredictor {
     return nlohmann::json::array({d->x(), d->y(), d->z()});
   }
   static constexpr double kLostResetS = 1.0;
-  static constexpr int kSupportedGatedRestart = 3;
   static constexpr int kFitEveryFrames = 10;
   void feed_until(double t_s) {
     const auto& imu = *imu_;
@@ -384,9 +354,8 @@ class ImuPredictor final : public TrackPredictor {
   bool pending_init_ = false, reset_done_ = false;
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
-  int supported_gated_ = 0, fallback_restarts_ = 0, gated_restarts_ = 0, weak_reacquisitions_ = 0, detection_restarts_ = 0;
-  int agreeing_restarts_ = 0;
-  GatedAgreement gated_;
+  int weak_reacquisitions_ = 0, detection_restarts_ = 0;
+  fusion::VisionArbiter arbiter_;  // who is wrong when vision and the filter disagree
   nlohmann::json verdict_;  // frame_verdict()
   ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
@@ -412,7 +381,7 @@ std::expected<std::unique_ptr<TrackPredictor>, std::string> make_track_predictor
     fusion::PredictorOptions options;
     options.mode = fusion::PredictorMode::ImuAided;
     options.imu_time_offset_s = imu_time_offset_s.value_or(0.0);
-    // Disagreement is settled here with the pose's support (ImuPredictor::observe): a strongly
+    // Disagreement is settled with the pose's support (fusion/vision_arbiter.h): a strongly
     // supported pose overrules the filter after three gated frames; a weak one only after half
     // a second of gated frames, when the filter is surely lost too.
     options.reinit_after_gated = 15;

@@ -45,6 +45,7 @@ struct OnboardLoop::Impl {
        fusion::Predictor pred, HeadController ctrl, std::unique_ptr<Recorder> rec)
       : model(&m), camera(cam), options(o), ports(p),
         vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
+        arbiter(o.predictor.gate_chi2),
         controller(std::move(ctrl)), target_point_obj(vision::model_centre(m)), imu_clock(clock_sync_options(o)),
         recorder(std::move(rec)) {}
 
@@ -54,6 +55,7 @@ struct OnboardLoop::Impl {
   OnboardPorts ports;
   VisionStage vision;
   fusion::Predictor predictor;
+  fusion::VisionArbiter arbiter;  // who is wrong when vision and the predictor disagree
   HeadController controller;
   Eigen::Vector3d target_point_obj;
   DeviceClockSync imu_clock;
@@ -228,6 +230,7 @@ struct OnboardLoop::Impl {
     if (r->detection && r->found && status != vision::TrackStatus::Lost) {
       // Found by detection: the predictor starts again from this pose, as from a start pose.
       predictor.reset();
+      arbiter.clear();
       last_good = report.cam_T_obj;
       init_t_s = r->exposure_t_s;
       init_pending = true;
@@ -240,7 +243,9 @@ struct OnboardLoop::Impl {
     }
     if (status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
-      predictor.add_vision(r->exposure_t_s, report.cam_T_obj, report.covariance);
+      // Vision and the filter disagree: the arbiter decides which is wrong, as `track` does.
+      arbiter.add_vision(predictor, r->exposure_t_s, report.cam_T_obj, report.covariance,
+                         {vision::strongly_supported(report), report.used_fallback});
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
       target_publish_t_s = published;
@@ -297,6 +302,8 @@ struct OnboardLoop::Impl {
                                           {"vision_rejected", st.counters.vision_too_old + st.counters.vision_out_of_order +
                                                                   st.counters.vision_bad_input + st.counters.vision_no_imu},
                                           {"reinitialisations", st.counters.reinitialisations},
+                                          {"restarts_from_vision", arbiter.counters().fallback + arbiter.counters().supported_gated +
+                                                                       arbiter.counters().agreeing_gated},
                                           {"imu_restarts", st.counters.imu_restarts},
                                           {"last_nis", st.last_nis}}},
                            {"commands_sent", summary.commands_sent},
@@ -476,6 +483,7 @@ std::expected<OnboardSummary, std::string> OnboardLoop::run(double until_s, cons
   out.imu_assembly = s.assembler.counters();
   out.imu_clock = s.imu_clock.counters();
   out.predictor = s.predictor.status(s.ports.clock->now_s()).counters;
+  out.predictor_restarts = s.arbiter.counters();
   return out;
 }
 

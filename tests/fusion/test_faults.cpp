@@ -9,6 +9,7 @@
 
 #include "epichead/fusion/predictor.h"
 #include "epichead/geometry/se3.h"
+#include "running_predictor.h"
 #include "truth_helpers.h"
 
 using namespace epichead::fusion;
@@ -19,32 +20,6 @@ namespace {
 
 constexpr double not_a_number = std::numeric_limits<double>::quiet_NaN();
 constexpr double infinity = std::numeric_limits<double>::infinity();
-
-// A predictor initialised at 0.2 s, run on exact readings to 0.5 s with 30 Hz poses to 0.4 s.
-struct Running {
-  Trajectory traj;
-  ImuRun imu = simulate_imu(traj, ImuErrors{}, 0.0, 1.0, 3);
-  Predictor predictor;
-  std::size_t next = 0;  // index of the next sample to give
-
-  explicit Running(const PredictorOptions& options = {}) : predictor(*Predictor::create(options)) {
-    feed_until(0.2);
-    REQUIRE(predictor.add_vision(0.2, traj.at(0.2).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict ==
-            VisionVerdict::Initialised);
-    for (int i = 1; i <= 6; ++i) {  // the last pose at 0.4 s: the tests add later ones
-      const double t = 0.2 + i / 30.0;
-      feed_until(t + 0.001);
-      REQUIRE(predictor.add_vision(t, traj.at(t).x.cam_T_obj(), pose_cov(1e-3, 1e-3)).verdict == VisionVerdict::Applied);
-    }
-    feed_until(0.5);
-  }
-  void feed_until(double t_s) {
-    for (; next < imu.samples.size() && imu.samples[next].t_s <= t_s + 1e-9; ++next) {
-      const ImuVerdict v = predictor.add_imu(imu.samples[next]);
-      REQUIRE((v == ImuVerdict::Accepted || v == ImuVerdict::Buffered));
-    }
-  }
-};
 
 bool same_state(const NavState& a, const NavState& b) {
   return a.obj_R_cam == b.obj_R_cam && a.obj_p_cam == b.obj_p_cam && a.obj_v_cam == b.obj_v_cam &&

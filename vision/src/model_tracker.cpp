@@ -54,6 +54,11 @@ const char* to_string(TrackStatus status) {
   return "unknown";
 }
 
+bool strongly_supported(const FrameReport& r) {
+  const int found = r.found + 2 * r.ellipses_found, kept = r.inliers + 2 * r.ellipses_found;
+  return r.status == TrackStatus::Tracked && kept >= 6 && kept >= 0.8 * found;
+}
+
 std::string to_string(TrackReason reasons) {
   static constexpr std::pair<TrackReason, const char*> names[] = {
       {TrackReason::NotVisible, "not_visible"}, {TrackReason::FewFeatures, "few_features"},

@@ -26,6 +26,7 @@
 
 #include "epichead/firmware_iface/candump_writer.h"
 #include "epichead/fusion/predictor.h"
+#include "epichead/fusion/vision_arbiter.h"
 #include "epichead/head/device_clock_sync.h"
 #include "epichead/head/head_controller.h"
 #include "epichead/head/imu_frame_assembler.h"
@@ -133,6 +134,7 @@ struct OnboardSummary {
   ImuAssemblyCounters imu_assembly;
   ClockSyncCounters imu_clock;  // time sync with the IMU: without it no IMU sample can be placed in time
   fusion::PredictorCounters predictor;
+  fusion::ArbiterCounters predictor_restarts;  // restarts from a vision pose that overruled the predictor, by reason
   // Acquisition (set_detector): detections run and how many found the object; losses (runs of
   // lost results) and re-acquisitions by detection; when detection first found the object.
   std::uint64_t detections = 0, detections_found = 0, losses = 0, reacquisitions = 0;

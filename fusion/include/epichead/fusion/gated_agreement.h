@@ -1,6 +1,6 @@
 #pragma once
-// Whether the vision poses the filter gates say the same thing (tools/track_prediction.cpp): a
-// run of them that agree with each other says the filter is off, not that vision had outliers.
+// Whether the vision poses the filter gates say the same thing (vision_arbiter.h): a run of them
+// that agree with each other says the filter is off, not that vision had outliers.
 //
 // Each gated pose's innovation (se3_log(vision * filter^-1), the update's own residual) is kept
 // with the pose's covariance for window_s. A new one agrees with an earlier one when their
@@ -14,14 +14,10 @@
 // time, with the lock found and applied in between. No run in a row formed, and the filter held
 // the lock for the whole run (0 % with the IMU, 97 % without, where the tracker walked off the
 // lock in three frames).
-#include <cstddef>
-
-#include <Eigen/Cholesky>
-
 #include "epichead/common/ring_buffer.h"
 #include "epichead/geometry/se3.h"
 
-namespace epichead::tools {
+namespace epichead::fusion {
 
 struct GatedAgreementOptions {
   double window_s = 0.4;   // a dozen frames at 30 fps: the filter's error barely turns with the camera
@@ -35,18 +31,7 @@ class GatedAgreement {
   // A gated pose at t_s: its innovation against the filter and its covariance. True when it and
   // at least restart_after - 1 others within window_s agree: the caller restarts the filter
   // from it (and calls clear()).
-  bool add(double t_s, const geometry::Vector6d& innovation, const geometry::Matrix6d& covariance) {
-    int agreeing = 1;
-    for (std::size_t k = 0; k < gated_.size(); ++k) {
-      const Entry& g = gated_[k];
-      if (!(t_s - g.t_s <= options_.window_s)) continue;
-      const geometry::Vector6d d = innovation - g.innovation;
-      const Eigen::LDLT<geometry::Matrix6d> sum(covariance + g.covariance);
-      if (sum.info() == Eigen::Success && d.dot(sum.solve(d)) <= options_.chi2) ++agreeing;
-    }
-    gated_.push_overwrite(Entry{t_s, innovation, covariance});
-    return agreeing >= options_.restart_after;
-  }
+  bool add(double t_s, const geometry::Vector6d& innovation, const geometry::Matrix6d& covariance);
   // After a restart (or the filter's own reset): the old innovations were against another state.
   void clear() { gated_.clear(); }
 
@@ -60,4 +45,4 @@ class GatedAgreement {
   common::RingBuffer<Entry, 16> gated_;  // the whole window up to 40 fps; at higher rates the newest 16
 };
 
-}  // namespace epichead::tools
+}  // namespace epichead::fusion

@@ -1,15 +1,15 @@
-// Whether gated vision poses agree with each other (tools/gated_agreement.h): three gated poses
+// Whether gated vision poses agree with each other (fusion/gated_agreement.h): three gated poses
 // that say the filter is off by the same error restart it, with applied poses between them or
 // not; gated poses that scatter (outliers), or that are too far apart in time, do not.
 #include <catch2/catch.hpp>
 
 #include <random>
 
-#include "gated_agreement.h"
+#include "epichead/fusion/gated_agreement.h"
 
 using epichead::geometry::Matrix6d;
 using epichead::geometry::Vector6d;
-using epichead::tools::GatedAgreement;
+using epichead::fusion::GatedAgreement;
 
 namespace {
 
