@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "epichead/fusion/predictor.h"
@@ -83,24 +84,31 @@ class ConstantVelocityPredictor final : public TrackPredictor {
 
 // Consistency of the vision updates: the normalised innovation squared (NIS) of a pose against
 // the filter's prediction is chi-square with 6 degrees of freedom when both covariances are
-// honest: mean 6, and 95 % of the values within [1.237, 14.449].
+// honest (5 for a body of revolution, whose turn is not compared: fusion/free_direction.h): mean 6
+// (5), and 95 % of the values within [1.237, 14.449] ([0.831, 12.833]).
 class NisStats {
  public:
-  void add(double nis) { if (std::isfinite(nis)) values_.push_back(nis); }
+  void add(double nis, int dims) {
+    if (std::isfinite(nis)) values_.push_back({nis, dims});
+  }
   nlohmann::json to_json() const {
     if (values_.empty()) return {{"count", 0}};
-    std::vector<double> v = values_;
-    std::sort(v.begin(), v.end());
-    double sum = 0;
+    std::vector<double> v;
+    v.reserve(values_.size());
+    double sum = 0, dims = 0;
     int below = 0, above = 0;
-    for (double x : v) {
+    for (const auto& [x, n] : values_) {
+      v.push_back(x);
       sum += x;
-      below += x < kChi2Low;
-      above += x > kChi2High;
+      dims += n;
+      below += x < (n == 5 ? kChi2Low5 : kChi2Low);
+      above += x > (n == 5 ? kChi2High5 : kChi2High);
     }
+    std::sort(v.begin(), v.end());
     const double n = static_cast<double>(v.size());
     return {{"count", v.size()},
             {"mean", sum / n},
+            {"mean_dof", dims / n},
             {"median", v[v.size() / 2]},
             {"below_chi2_2.5pct", below / n},
             {"above_chi2_97.5pct", above / n},
@@ -108,8 +116,8 @@ class NisStats {
   }
 
  private:
-  static constexpr double kChi2Low = 1.237, kChi2High = 14.449;
-  std::vector<double> values_;
+  static constexpr double kChi2Low = 1.237, kChi2High = 14.449, kChi2Low5 = 0.831, kChi2High5 = 12.833;
+  std::vector<std::pair<double, int>> values_;
 };
 
 // The Kalman predictor fed with the sequence's imu.csv: before each frame every IMU sample up
@@ -204,7 +212,7 @@ class ImuPredictor final : public TrackPredictor {
     const fusion::ArbitratedVision a = arbiter_.add_vision(predictor_, t_s, report.cam_T_obj, report.covariance, support);
     const fusion::VisionVerdict first = a.result.verdict;
     const bool measured = first == fusion::VisionVerdict::Applied || first == fusion::VisionVerdict::Gated;
-    if (measured) nis_.add(a.result.mahalanobis2);
+    if (measured) nis_.add(a.result.mahalanobis2, a.result.dims);
     const char* restart = fusion::to_string(a.restart);
     verdict_ = {{"verdict", fusion::to_string(first)},
                 {"nis", measured ? nlohmann::json(a.result.mahalanobis2) : nlohmann::json(nullptr)},

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "epichead/fusion/free_direction.h"
 #include "epichead/geometry/pose_covariance.h"
 #include "epichead/geometry/se3.h"
 #include "epichead/geometry/so3.h"
@@ -36,7 +37,7 @@ bool ConstantVelocityFilter::initialise(double t_s, const Eigen::Isometry3d& cam
   omega_cam_radps_.setZero();
   P_.setZero();
   const Matrix6d J = geometry::filter_pose_error_jacobian(obj_R_cam_);
-  P_.topLeftCorner<6, 6>() = J * cov * J.transpose();
+  P_.topLeftCorner<6, 6>() = J * start_covariance(cov) * J.transpose();
   P_.block<3, 3>(v, v).diagonal().setConstant(noise_.initial_speed_mps * noise_.initial_speed_mps);
   P_.block<3, 3>(w, w).diagonal().setConstant(noise_.initial_rate_radps * noise_.initial_rate_radps);
   return true;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "epichead/fusion/free_direction.h"
 #include "epichead/fusion/imu_propagation.h"
 #include "epichead/geometry/pose_covariance.h"
 #include "epichead/geometry/se3.h"
@@ -115,7 +116,7 @@ bool ImuFilter::initialise(double t_s, const Eigen::Isometry3d& cam_T_obj, const
 
   ErrorCovariance P = ErrorCovariance::Zero();
   const Matrix6d J = geometry::filter_pose_error_jacobian(x.obj_R_cam);
-  P.topLeftCorner<6, 6>() = J * cov * J.transpose();
+  P.topLeftCorner<6, 6>() = J * start_covariance(cov) * J.transpose();
   const auto sq = [](double s) { return s * s; };
   P.diagonal().segment<3>(err::v).setConstant(sq(options_.initial_speed_mps));
   P.diagonal().segment<3>(err::bg).setConstant(sq(options_.initial_gyro_bias_radps));

@@ -285,7 +285,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
       imu_.drop_carried_motion();
     }
     if (++status_.gated_in_a_row >= options_.reinit_after_gated) reinit_pending_ = true;
-    return {VisionVerdict::Gated, r->mahalanobis2};
+    return {VisionVerdict::Gated, r->mahalanobis2, r->dims};
   }
   ++c.vision_applied;
   status_.gated_in_a_row = 0;
@@ -299,7 +299,7 @@ VisionResult Predictor::add_vision(double t_s, const Eigen::Isometry3d& cam_T_ob
       const double sigma = std::sqrt(e->P.block<2, 2>(err::grav, err::grav).diagonal().maxCoeff());
       gravity_.learn(t_s, e->x.gravity_obj_mps2(), sigma, e->x.gyro_bias_radps, e->x.accel_bias_mps2, applied_in_a_row_);
     }
-  return {VisionVerdict::Applied, r->mahalanobis2};
+  return {VisionVerdict::Applied, r->mahalanobis2, r->dims};
 }
 
 bool Predictor::resumes_after_gap(double t_s, const Eigen::Isometry3d& cam_T_obj) const {

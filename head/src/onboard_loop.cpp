@@ -244,8 +244,17 @@ struct OnboardLoop::Impl {
     if (status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
       // Vision and the filter disagree: the arbiter decides which is wrong, as `track` does.
-      arbiter.add_vision(predictor, r->exposure_t_s, report.cam_T_obj, report.covariance,
-                         {vision::strongly_supported(report), report.used_fallback});
+      const fusion::VisionVerdict v = arbiter.add_vision(predictor, r->exposure_t_s, report.cam_T_obj, report.covariance,
+                                                         {vision::strongly_supported(report), report.used_fallback})
+                                          .final()
+                                          .verdict;
+      // A tracked pose supersedes the start pose as the filter's seed, whether it started the
+      // filter or could not yet (no IMU sample before it, or too old), as in `track`. Before, the
+      // start pose was offered again with every frame and refused each time (vision_rejected
+      // counted every frame of every sim-run).
+      if (v == fusion::VisionVerdict::NoImu || v == fusion::VisionVerdict::TooOld || v == fusion::VisionVerdict::Initialised ||
+          v == fusion::VisionVerdict::Applied)
+        init_pending = false;
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
       target_publish_t_s = published;

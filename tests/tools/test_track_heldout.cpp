@@ -53,6 +53,9 @@ TEST_CASE("track --imu on follows a held-out lampshade, names its free turn's ax
   const auto& nis = report["predictor"]["vision_nis"];
   INFO(nis.dump());
   CHECK(nis["count"].get<int>() > 0);
+  // Each compared in the five directions vision measures, the turn about the axis left out
+  // (fusion/free_direction.h).
+  CHECK(nis["mean_dof"].get<double>() == Approx(5.0));
 
   const auto score = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --sym-axis 0,0,1 --json");
   INFO(score.err);

@@ -62,6 +62,7 @@ const char* to_string(VisionVerdict verdict);
 struct VisionResult {
   VisionVerdict verdict = VisionVerdict::BadInput;
   double mahalanobis2 = 0;  // squared Mahalanobis distance of the innovation (Applied, Gated)
+  int dims = 6;             // its degrees of freedom: 5 for a pose with a free direction (free_direction.h)
 };
 
 struct PredictorCounters {
