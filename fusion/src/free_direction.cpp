@@ -1,5 +1,7 @@
 #include "epichead/fusion/free_direction.h"
 
+#include <cmath>
+
 #include <Eigen/Eigenvalues>
 
 namespace epichead::fusion {

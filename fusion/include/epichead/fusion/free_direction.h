@@ -12,13 +12,20 @@
 // velocity and gravity learnt the jump, every pose after it was gated, 3.7 % success. So:
 //   - an update measures the five other directions only (the innovation and covariance projected
 //     onto them): the pose's turn, wherever it was left, never pulls the filter nor gates a pose;
-//   - a filter started from such a pose gives the turn kStartSigmaRad, a gauge: which turn of a
+//   - a filter started from such a pose gives the turn kFreeTurnStartSigmaRad, a gauge: which turn of a
 //     body that looks the same at every turn the filter holds is arbitrary, and the gyro carries it.
 #include <optional>
 
 #include "epichead/geometry/se3.h"
 
 namespace epichead::fusion {
+
+// Free: the covariance's largest eigenvalue at least this many times the next ...
+inline constexpr double kFreeDirectionMinRatio = 1e3;
+// ... with at least this much turn along it (a pose whose depth alone is loose is not free).
+inline constexpr double kFreeDirectionMinTurnSigmaRad = 0.2;
+// The turn's sigma a filter started from such a pose holds.
+inline constexpr double kFreeTurnStartSigmaRad = 0.05;
 
 struct FreeDirection {
   geometry::Vector6d direction;        // unit, left perturbation (translation, rotation)
@@ -27,11 +34,10 @@ struct FreeDirection {
   double turn_sigma_rad = 0;           // the turn's sigma the covariance gives along `direction`
 };
 
-// The covariance's free direction: its largest eigenvalue at least kMinRatio times the next, with
-// a turn of at least kMinTurnSigmaRad along it (a pose whose depth alone is loose is not free).
+// The covariance's free direction (kFreeDirectionMinRatio, kFreeDirectionMinTurnSigmaRad), or nothing.
 std::optional<FreeDirection> find_free_direction(const geometry::Matrix6d& cov);
 
-// The covariance a filter starts from: the free direction's sigma brought to kStartSigmaRad of turn.
+// `cov` with the free direction's sigma brought to kFreeTurnStartSigmaRad of turn.
 geometry::Matrix6d with_free_turn_fixed(const geometry::Matrix6d& cov, const FreeDirection& free);
 
 // `cov` with its free direction's turn at kFreeTurnStartSigmaRad, or `cov` when it has none.
@@ -39,9 +45,5 @@ inline geometry::Matrix6d start_covariance(const geometry::Matrix6d& cov) {
   const auto free = find_free_direction(cov);
   return free ? with_free_turn_fixed(cov, *free) : cov;
 }
-
-inline constexpr double kFreeDirectionMinRatio = 1e3;
-inline constexpr double kFreeDirectionMinTurnSigmaRad = 0.2;
-inline constexpr double kFreeTurnStartSigmaRad = 0.05;
 
 }  // namespace epichead::fusion
