@@ -285,8 +285,8 @@ TEST_CASE("sim-run leaves the frames a cover board hides the object in out of th
 TEST_CASE("sim-run: gated poses that agree restart the predictor, as in track (fusion/vision_arbiter.h)", "[tools][sim-run]") {
   TempDir dir("sim_run_arbiter");
   // box_clutter, seed 2: at 1.7-1.8 s the predictor gates three poses that agree with each other;
-  // the third restarts it from vision. Without the arbiter the filter gated 8 poses by 2 s, the
-  // last 5 in a row before it re-initialised itself (reinit_after_gated).
+  // the third restarts it from vision. Without the arbiter the filter gated 8 poses by 2 s and
+  // re-initialised itself once.
   const auto r = run_epichead(dir, "sim-run box_clutter --seed 2 --seconds 2 --every 0 --out '" + dir.str() + "/out'");
   INFO(r.out << r.err);
   REQUIRE(r.exit_code == 0);
