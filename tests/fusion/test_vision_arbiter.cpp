@@ -100,7 +100,7 @@ TEST_CASE("vision arbiter: three well-supported gated poses in a row restart the
   CHECK(arbiter.counters().agreeing_gated == 0);
 }
 
-TEST_CASE("vision arbiter: gated poses that agree restart the filter with applied ones between them; clear() forgets them") {
+TEST_CASE("vision arbiter: gated poses that agree restart the filter with applied ones between them, and clear() forgets them") {
   for (const bool cleared : {false, true}) {
     Running r(no_reinit());
     VisionArbiter arbiter(r.predictor.options().gate_chi2);
