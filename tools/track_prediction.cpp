@@ -219,11 +219,7 @@ class ImuPredictor final : public TrackPredictor {
                 {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)}};
     if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
     const fusion::VisionResult& r = a.final();
-    // A tracked pose supersedes the init pose as the filter's seed, whether it started the
-    // filter or could not yet (no IMU sample before it, or too old).
-    if (r.verdict == fusion::VisionVerdict::NoImu || r.verdict == fusion::VisionVerdict::TooOld ||
-        r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied)
-      pending_init_ = false;
+    if (fusion::supersedes_start_pose(r.verdict)) pending_init_ = false;
     if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) last_applied_t_s_ = t_s;
   }
   std::optional<Eigen::Isometry3d> coasted(double t_s, double max_age_s) override {

@@ -248,13 +248,9 @@ struct OnboardLoop::Impl {
                                                          {vision::strongly_supported(report), report.used_fallback})
                                           .final()
                                           .verdict;
-      // A tracked pose supersedes the start pose as the filter's seed, whether it started the
-      // filter or could not yet (no IMU sample before it, or too old), as in `track`. Before, the
-      // start pose was offered again with every frame and refused each time (vision_rejected
-      // counted every frame of every sim-run).
-      if (v == fusion::VisionVerdict::NoImu || v == fusion::VisionVerdict::TooOld || v == fusion::VisionVerdict::Initialised ||
-          v == fusion::VisionVerdict::Applied)
-        init_pending = false;
+      // Before, the start pose was offered again with every frame and refused each time
+      // (vision_rejected counted every frame of every sim-run).
+      if (fusion::supersedes_start_pose(v)) init_pending = false;
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
       target_publish_t_s = published;

@@ -58,6 +58,12 @@ enum class VisionVerdict {
 
 const char* to_string(ImuVerdict verdict);
 const char* to_string(VisionVerdict verdict);
+// Whether a tracked pose with this verdict supersedes a start pose (init.csv, the robot's
+// init_pose) as the filter's seed: it started or updated the filter, or the filter could not yet
+// take any pose then (no IMU sample before it, or too old). `track` and the onboard loop alike.
+inline bool supersedes_start_pose(VisionVerdict v) {
+  return v == VisionVerdict::NoImu || v == VisionVerdict::TooOld || v == VisionVerdict::Initialised || v == VisionVerdict::Applied;
+}
 
 struct VisionResult {
   VisionVerdict verdict = VisionVerdict::BadInput;
