@@ -127,7 +127,9 @@ void draw_frame(cv::Mat& canvas, const ModelTracker& tracker, const FrameReport&
 
 // report.json's entry for one frame: status, stage times and feature counts.
 nlohmann::json frame_json(const FrameEntry& entry, const FrameReport& report) {
-  return {{"frame", entry.frame},
+  const auto support = [](const std::optional<double>& s) { return s ? nlohmann::json(*s) : nlohmann::json(nullptr); };
+  const EllipseRefusals& refused = report.ellipses_refused;
+  nlohmann::json frame = {{"frame", entry.frame},
                      {"t_s", entry.t_s},
                      {"status", to_string(report.status)},
                      {"reasons", to_string(report.reasons)},
@@ -144,11 +146,21 @@ nlohmann::json frame_json(const FrameEntry& entry, const FrameReport& report) {
                                 {"changed_by_validation", report.validated_changed}}},
                      {"ellipses", {{"visible", report.ellipses_visible},
                                    {"found", report.ellipses_found},
-                                   {"weak", report.ellipses_weak}}},
+                                   {"weak", report.ellipses_weak},
+                                   {"refused", {{"no_candidate", refused.no_candidate},
+                                                {"leaves_window", refused.leaves_window},
+                                                {"other_shape", refused.other_shape},
+                                                {"few_lines", refused.few_lines}}}}},
                      {"junctions", report.junctions},
                      {"combinations", report.combinations},
                      {"scale_px", report.scale_px},
                      {"pose_iterations", report.pose_iterations}};
+  // Only on a start (the first frame, the first after a loss or a detection).
+  if (report.start.settled)
+    frame["start"] = {{"kept", report.start.kept_gradient ? "gradient_pass" : "given"},
+                      {"support_given", support(report.start.support_given)},
+                      {"support_gradient_pass", support(report.start.support_gradient)}};
+  return frame;
 }
 
 // The PNG overlays (every Nth frame, optionally a zoomed region) and the overlay video of a run.

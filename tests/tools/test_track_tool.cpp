@@ -78,6 +78,41 @@ TEST_CASE("track follows a short simulated mockup_walk with epic+validation and 
   CHECK(c["scale_for_mean"].get<double>() < 5.0);
 }
 
+TEST_CASE("track's report says which start a start frame kept and why a rim was not found") {
+  TempDir tmp("epichead_test_track_start_report");
+  const std::string seq = tmp / "can", out = tmp / "track";
+  REQUIRE(run_epichead(tmp, "sim can --out " + q(seq) + " --frames 8").exit_code == 0);
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video");
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  const auto frames = nlohmann::json::parse(slurp(out + "/report.json"))["per_frame"];
+  REQUIRE(frames.size() == 8);
+  // Frame 0 is a start from init.csv: the settle's choice and both supports.
+  const auto& start = frames[0]["start"];
+  REQUIRE(start.is_object());
+  const auto& given = start["support_given"];
+  const auto& gradient = start["support_gradient_pass"];
+  if (start["kept"] == "gradient_pass") {
+    // Kept only when usable and at least as well supported as the given start's measurement.
+    REQUIRE(gradient.is_number());
+    if (given.is_number()) CHECK(gradient.get<double>() >= given.get<double>());
+  } else {
+    CHECK(start["kept"] == "given");
+    if (given.is_number() && gradient.is_number()) CHECK(given.get<double>() > gradient.get<double>());
+  }
+  // A frame after a tracked one is no start.
+  if (frames[0]["status"] != "lost") CHECK_FALSE(frames[1].contains("start"));
+  // Every visible rim is found or refused for one reason.
+  for (const auto& f : frames) {
+    const auto& e = f["ellipses"];
+    int refused = 0;
+    for (const char* why : {"no_candidate", "leaves_window", "other_shape", "few_lines"}) refused += e["refused"][why].get<int>();
+    INFO("frame " << f["frame"]);
+    CHECK(refused == e["visible"].get<int>() - e["found"].get<int>());
+  }
+  CHECK(frames[3]["ellipses"]["visible"].get<int>() == 2);  // the can's two rims
+}
+
 TEST_CASE("track --imu on finds the IMU clock offset from the gyro and the tracked poses (auto) and tracks every frame") {
   TempDir tmp("epichead_test_track_offset");
   const std::string seq = tmp / "mockup_walk", out = tmp / "track";

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -205,4 +206,43 @@ TEST_CASE("the ellipse tracker survives garbage projections and an ellipse outsi
   tracker.reset();
   tracker.track_one(image, 2, make(151, 121, 60, 40, 0), WindowPlacement::Previous);
   CHECK(tracker.features().at(2).found);
+}
+
+TEST_CASE("a rim the tracker does not find says why: no candidate, another contour's shape", "[ellipse_tracker]") {
+  WindowImage image;
+  REQUIRE(image.assign(frame(make(160, 120, 70, 45, 0.2), 1e9, 3)));
+  {
+    // Placed 1.5 px off: found, nothing refused.
+    EllipseTracker tracker;
+    tracker.track_one(image, 0, make(161.5, 120, 70, 45, 0.2), WindowPlacement::Projection);
+    const EllipseFeature& f = tracker.features().at(0);
+    REQUIRE(f.found);
+    CHECK(f.refused == EllipseRefusal::None);
+  }
+  {
+    // Placed a quarter smaller (the prediction a quarter too far): the lines find the disc's
+    // contour, whose size the prediction rules out.
+    EllipseTracker tracker;
+    tracker.track_one(image, 0, make(160, 120, 52.5, 33.75, 0.2), WindowPlacement::Projection);
+    const EllipseFeature& f = tracker.features().at(0);
+    REQUIRE(f.visible);
+    CHECK_FALSE(f.found);
+    CHECK(f.refused == EllipseRefusal::OtherShape);
+    CHECK(std::string(to_string(f.refused)) == "other_shape");
+  }
+  {
+    // A frame without edges: nothing to fit.
+    WindowImage blank;
+    REQUIRE(blank.assign(cv::Mat(240, 320, CV_8UC3, cv::Scalar(128, 128, 128))));
+    EllipseTracker tracker;
+    tracker.track_one(blank, 0, make(160, 120, 70, 45, 0.2), WindowPlacement::Projection);
+    const EllipseFeature& f = tracker.features().at(0);
+    REQUIRE(f.visible);
+    CHECK_FALSE(f.found);
+    CHECK(f.refused == EllipseRefusal::NoCandidate);
+    // Found again on the frame with the disc: the reason does not stay.
+    tracker.track_one(image, 0, make(161.5, 120, 70, 45, 0.2), WindowPlacement::Projection);
+    CHECK(tracker.features().at(0).found);
+    CHECK(tracker.features().at(0).refused == EllipseRefusal::None);
+  }
 }

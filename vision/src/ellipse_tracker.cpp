@@ -7,6 +7,17 @@
 #include <numbers>
 
 namespace epichead::vision {
+
+const char* to_string(EllipseRefusal refusal) {
+  switch (refusal) {
+    case EllipseRefusal::None: return "none";
+    case EllipseRefusal::NoCandidate: return "no_candidate";
+    case EllipseRefusal::LeavesWindow: return "leaves_window";
+    case EllipseRefusal::OtherShape: return "other_shape";
+    case EllipseRefusal::FewLines: return "few_lines";
+  }
+  return "?";
+}
 namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
@@ -58,6 +69,7 @@ void EllipseTracker::reset() {
     f.refs = {};
     f.has_previous = false;
     f.visible = f.found = f.weak = false;
+    f.refused = EllipseRefusal::None;
     f.selected = -1;
     f.arc = {};
   }
@@ -83,7 +95,10 @@ void EllipseTracker::track(const WindowImage& image, const VisibleModel& visible
   int max_circle = -1;
   for (const VisibleEllipse& e : visible.ellipses) max_circle = std::max(max_circle, e.circle);
   if (max_circle >= 0) feature(max_circle);
-  for (EllipseFeature& f : features_) f.visible = f.found = f.weak = false;
+  for (EllipseFeature& f : features_) {
+    f.visible = f.found = f.weak = false;
+    f.refused = EllipseRefusal::None;
+  }
   for (EllipseFeature& f : features_) {
     bool seen = false;
     for (const VisibleEllipse& e : visible.ellipses) seen = seen || e.circle == f.circle;
@@ -127,6 +142,7 @@ void EllipseTracker::track_one(const WindowImage& image, int circle, const Ellip
   if (circle < 0) return;
   EllipseFeature& f = feature(circle);
   f.visible = f.found = f.weak = false;
+  f.refused = EllipseRefusal::None;
   f.selected = -1;
   f.candidates.clear();
   f.candidate_inliers.clear();
@@ -311,6 +327,11 @@ void EllipseTracker::fit(EllipseFeature& f) {
                             static_cast<int>(std::ceil(options_.min_support_ratio * static_cast<float>(arc_lines))));
   f.row_hit.assign(f.lines.size(), 0);
   bool other_shape = false, moved_tried = false;
+  // The first refused candidate is the best supported: its reason is the feature's.
+  f.refused = EllipseRefusal::NoCandidate;
+  const auto refuse = [&f](EllipseRefusal why) {
+    if (f.refused == EllipseRefusal::NoCandidate) f.refused = why;
+  };
   for (int c = 0;; ++c) {
     if (c == static_cast<int>(f.candidates.size())) {
       if (!other_shape || moved_tried || options_.mode != EpicMode::Epic || !f.placed_arc.full()) break;
@@ -320,8 +341,12 @@ void EllipseTracker::fit(EllipseFeature& f) {
       f.candidates.push_back(moved);  // within the reserved capacity
     }
     const EllipseFit& cand = f.candidates[static_cast<std::size_t>(c)];
-    if (!plausible(f, cand.ellipse)) continue;
+    if (!plausible(f, cand.ellipse)) {
+      refuse(EllipseRefusal::LeavesWindow);
+      continue;
+    }
     if (!placed_shape(f, cand.ellipse)) {
+      refuse(EllipseRefusal::OtherShape);
       other_shape = true;
       continue;
     }
@@ -330,9 +355,13 @@ void EllipseTracker::fit(EllipseFeature& f) {
       f.row_hit[static_cast<std::size_t>(f.result.edgels.edgels[static_cast<std::size_t>(f.candidate_inliers[static_cast<std::size_t>(cand.inlier_begin + q)])].row)] = 1;
     int rows_hit = 0;
     for (unsigned char h : f.row_hit) rows_hit += h;
-    if (rows_hit < need) continue;
+    if (rows_hit < need) {
+      refuse(EllipseRefusal::FewLines);
+      continue;
+    }
     f.selected = c;
     f.found = true;
+    f.refused = EllipseRefusal::None;
     if (!f.placed_arc.full() && f.placed_arc.span_rad < options_.weak_arc_rad) {
       // A free ellipse through a short arc swings about it (five parameters, little curvature
       // seen); keep the shape the lines were placed on and fit only its shift, from the inliers'

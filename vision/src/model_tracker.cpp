@@ -7,6 +7,17 @@
 namespace epichead::vision {
 namespace {
 
+void count_refusal(EllipseRefusal refusal, EllipseRefusals& counts) {
+  switch (refusal) {
+    case EllipseRefusal::None: break;
+    case EllipseRefusal::NoCandidate: ++counts.no_candidate; break;
+    case EllipseRefusal::LeavesWindow: ++counts.leaves_window; break;
+    case EllipseRefusal::OtherShape: ++counts.other_shape; break;
+    case EllipseRefusal::FewLines: ++counts.few_lines; break;
+  }
+}
+
+
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
@@ -207,12 +218,14 @@ bool ModelTracker::measure(const WindowImage& image, const Eigen::Isometry3d& pr
     out.found += f.visible && f.selected >= 0;
   }
   out.ellipses_visible = out.ellipses_found = out.ellipses_weak = 0;
+  out.ellipses_refused = {};
   for (EllipseObservation& obs : problem_.ellipses) obs.points_px.clear();
   if (!visible_.ellipses.empty()) {
     t = Clock::now();
     ellipses_.track(image, visible_, WindowPlacement::ProjectionOnArc);
     for (const EllipseFeature& f : ellipses_.features()) {
       out.ellipses_visible += f.visible;
+      if (f.visible) count_refusal(f.refused, out.ellipses_refused);
       if (!f.visible || !f.found || f.circle < 0 || f.circle >= static_cast<int>(problem_.ellipses.size())) continue;
       EllipseObservation& obs = problem_.ellipses[static_cast<std::size_t>(f.circle)];
       if (ellipses_.observation(f, model_->circles[static_cast<std::size_t>(f.circle)], obs)) {
@@ -307,8 +320,9 @@ void ModelTracker::set_mode(TrackMode mode) {
 }
 
 Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times,
-                                       FrameReport& measured, bool& reused) {
+                                       FrameReport& measured, bool& reused, StartSettle& record) {
   reused = false;
+  record = StartSettle{};
   // How well the image supports a measurement: the share of found features the pose keeps.
   const auto support = [](const FrameReport& r) {
     return static_cast<double>(r.inliers + 2 * r.ellipses_found) / std::max(1, r.found + 2 * r.ellipses_found);
@@ -322,13 +336,17 @@ Eigen::Isometry3d ModelTracker::settle(const WindowImage& image, const Eigen::Is
   set_mode(mode);
   times.add_stages(direct.times);
   times.add_stages(gradient.times);
+  record.settled = true;
+  if (direct_ok) record.support_given = support(direct);
   if (!gradient_ok) return predicted;
   // References afresh from the gradient pose's projection.
   lines_.reset();
   ellipses_.reset();
   const bool refined_ok = measure(image, gradient.cam_T_obj, refined);
   times.add_stages(refined.times);
+  if (refined_ok) record.support_gradient = support(refined);
   if (refined_ok && (!direct_ok || support(refined) >= support(direct))) {
+    record.kept_gradient = true;
     // The tracker's state (features, validation, pose) is still that of the refined measurement,
     // and a line's measurement depends only on the image, the pose and its references. Not so
     // an ellipse's: its tracker lines are placed on the arc its last measurement found.
@@ -365,7 +383,9 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
     settling.epic_ms += ms_since(t);
   }
   bool reused = false;
-  const Eigen::Isometry3d start = settled_ || !options_.settle ? predicted : settle(image, predicted, settling, out, reused);
+  StartSettle start_record;
+  const Eigen::Isometry3d start =
+      settled_ || !options_.settle ? predicted : settle(image, predicted, settling, out, reused, start_record);
   bool pose_ok = reused || measure(image, start, out);
   out.times.add_stages(settling);
   if (!pose_ok && fallback) {
@@ -412,6 +432,7 @@ void ModelTracker::track(const WindowImage& image, const Eigen::Isometry3d& pred
     }
   }
   out.reasons = reasons;
+  out.start = start_record;
   was_lost_ = out.status == TrackStatus::Lost;
   settled_ = !was_lost_;
   std::swap(kept_last_, kept_now_);

@@ -7,6 +7,7 @@
 // beyond each end watches for the occluder to leave; the arc grows back line by line. An arc
 // under 180 deg is flagged weak: an ellipse fitted to it is poorly constrained.
 // Allocation-free after warm-up (each feature's buffers are reserved when first seen).
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -55,12 +56,25 @@ struct EllipseTrackerOptions {
   double max_openness_change = 0.1;
 };
 
+// Why a visible circle's ellipse was not found this frame: the best-supported candidate's
+// reason, or that there was none. On a start from init.csv a can's rims are refused for these
+// reasons while its silhouettes are found; report.json counts them per frame.
+enum class EllipseRefusal : std::uint8_t {
+  None,          // found, or no tracker lines placed
+  NoCandidate,   // RANSAC fitted no ellipse to the good edgels
+  LeavesWindow,  // the candidate leaves the window of an arc line (EllipseTracker::plausible)
+  OtherShape,    // its size or openness is another contour's (max_size_change, max_openness_change)
+  FewLines,      // its inliers lie on too few tracker lines (min_support_ratio)
+};
+const char* to_string(EllipseRefusal refusal);
+
 // State and latest result of one model circle.
 struct EllipseFeature {
   int circle = -1;                // index into CadModel::circles
   bool visible = false;           // tracker lines were placed this frame
   bool found = false;             // an ellipse was selected this frame
   bool weak = false;              // the found arc subtends less than weak_arc_rad
+  EllipseRefusal refused = EllipseRefusal::None;  // why a visible circle was not found
   ObjectSide side = ObjectSide::Left;
   Ellipse placed_on;              // the ellipse the tracker lines were placed on
   EllipseArc placed_arc;          // ... and the arc they were spread over

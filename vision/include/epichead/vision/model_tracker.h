@@ -112,6 +112,20 @@ struct StageTimes {
   }
 };
 
+// Visible circles whose ellipse was not found, by the reason (EllipseRefusal).
+struct EllipseRefusals {
+  int no_candidate = 0, leaves_window = 0, other_shape = 0, few_lines = 0;
+};
+
+// How a start (init.csv, a detection, the first frame after a loss) was settled (settle()):
+// measured from the given pose and from a gradient pass's pose, the better supported kept.
+// Support is the share of found features the pose kept (a line counts one, an ellipse two).
+struct StartSettle {
+  bool settled = false;          // this frame was a start and settle() ran
+  bool kept_gradient = false;    // the frame was measured from the gradient pass's pose
+  std::optional<double> support_given, support_gradient;  // empty: that measurement was unusable
+};
+
 struct FrameReport {
   TrackStatus status = TrackStatus::Lost;
   TrackReason reasons = TrackReason::None;
@@ -126,12 +140,14 @@ struct FrameReport {
   int visible = 0;                 // line windows placed
   int found = 0;                   // windows with at least one candidate
   int ellipses_visible = 0, ellipses_found = 0, ellipses_weak = 0;  // model circles (weak: arc < 180 deg)
+  EllipseRefusals ellipses_refused;
   int validated_changed = 0;       // features where validation chose another than RANSAC's best
   int junctions = 0;               // junction points given to the pose
   int inliers = 0, rejected = 0;   // found lines the pose kept / rejected as outliers
   int recovered = 0;               // lines found and kept that were lost or rejected last frame
   int combinations = 0;            // candidate combinations validation examined
   bool used_fallback = false;      // the pose was measured from the fallback prediction
+  StartSettle start;
   StageTimes times;
 };
 
@@ -181,9 +197,9 @@ class ModelTracker {
   // is returned, with the references of that start. When that start is the gradient pass's and
   // no ellipse is seen, its EPIC measurement was settle()'s last and is left in `measured`
   // (reused set): measuring again from the same start with the same references would repeat it
-  // exactly, a quarter of a start's cost.
+  // exactly, a quarter of a start's cost. `record` says which start was kept and why.
   Eigen::Isometry3d settle(const WindowImage& image, const Eigen::Isometry3d& predicted, StageTimes& times,
-                           FrameReport& measured, bool& reused);
+                           FrameReport& measured, bool& reused, StartSettle& record);
   void set_mode(TrackMode mode);
   const CadModel* model_;
   Camera camera_;
