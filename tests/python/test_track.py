@@ -34,6 +34,16 @@ def test_tracks_the_teabox_from_its_init_pose(teabox):
     assert r.times_ms["total"] > 0
 
 
+def test_a_start_frame_says_which_start_it_kept(teabox):
+    tracker = epichead.Tracker(teabox.camera, teabox.model)
+    first, second = track_frames(teabox, tracker, frames=2)
+    assert first.start["kept"] in ("given", "gradient_pass")
+    given, gradient = first.start["support_given"], first.start["support_gradient_pass"]
+    if first.start["kept"] == "gradient_pass":
+        assert gradient is not None and (given is None or gradient >= given)
+    assert second.start is None  # tracked on from the first frame: no start
+
+
 def test_per_edge_results_name_model_edges_and_chosen_lines(teabox):
     tracker = epichead.Tracker(teabox.camera, teabox.model)
     r = track_frames(teabox, tracker, frames=1)[0]

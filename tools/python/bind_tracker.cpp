@@ -161,6 +161,22 @@ void bind_tracker(py::module_& m) {
       .def_property_readonly("inliers", [](const FrameResult& r) { return r.report.inliers; })
       .def_property_readonly("rejected", [](const FrameResult& r) { return r.report.rejected; })
       .def_property_readonly("used_fallback", [](const FrameResult& r) { return r.report.used_fallback; })
+      .def_property_readonly(
+          "start",
+          [](const FrameResult& r) -> py::object {
+            const StartSettle& s = r.report.start;
+            if (!s.settled) return py::none();
+            const auto support = [](const std::optional<double>& v) -> py::object {
+              if (v) return py::float_(*v);
+              return py::none();
+            };
+            return py::dict(py::arg("kept") = s.kept_gradient ? "gradient_pass" : "given",
+                            py::arg("support_given") = support(s.support_given),
+                            py::arg("support_gradient_pass") = support(s.support_gradient));
+          },
+          "on a start (the first frame, the first after a loss or reset()): which start the frame was measured from, "
+          "'given' or 'gradient_pass', and the share of found features each measurement kept (None: unusable); "
+          "None on other frames")
       .def_property_readonly("times_ms",
                              [](const FrameResult& r) {
                                const StageTimes& t = r.report.times;

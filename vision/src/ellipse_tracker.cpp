@@ -18,6 +18,7 @@ const char* to_string(EllipseRefusal refusal) {
   }
   return "?";
 }
+
 namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;

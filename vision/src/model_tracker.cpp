@@ -17,7 +17,6 @@ void count_refusal(EllipseRefusal refusal, EllipseRefusals& counts) {
   }
 }
 
-
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
