@@ -209,40 +209,31 @@ TEST_CASE("the ellipse tracker survives garbage projections and an ellipse outsi
 }
 
 TEST_CASE("a rim the tracker does not find says why: no candidate, another contour's shape", "[ellipse_tracker]") {
-  WindowImage image;
+  WindowImage image, blank;
   REQUIRE(image.assign(frame(make(160, 120, 70, 45, 0.2), 1e9, 3)));
-  {
-    // Placed 1.5 px off: found, nothing refused.
-    EllipseTracker tracker;
-    tracker.track_one(image, 0, make(161.5, 120, 70, 45, 0.2), WindowPlacement::Projection);
-    const EllipseFeature& f = tracker.features().at(0);
-    REQUIRE(f.found);
-    CHECK(f.refused == EllipseRefusal::None);
-  }
-  {
-    // Placed a quarter smaller (the prediction a quarter too far): the lines find the disc's
-    // contour, whose size the prediction rules out.
-    EllipseTracker tracker;
-    tracker.track_one(image, 0, make(160, 120, 52.5, 33.75, 0.2), WindowPlacement::Projection);
+  REQUIRE(blank.assign(cv::Mat(240, 320, CV_8UC3, cv::Scalar(128, 128, 128))));  // no edges at all
+  EllipseTracker tracker;
+  const auto track = [&](const WindowImage& on, const Ellipse& placed) -> const EllipseFeature& {
+    tracker.reset();
+    tracker.track_one(on, 0, placed, WindowPlacement::Projection);
     const EllipseFeature& f = tracker.features().at(0);
     REQUIRE(f.visible);
-    CHECK_FALSE(f.found);
-    CHECK(f.refused == EllipseRefusal::OtherShape);
-    CHECK(std::string(to_string(f.refused)) == "other_shape");
-  }
-  {
-    // A frame without edges: nothing to fit.
-    WindowImage blank;
-    REQUIRE(blank.assign(cv::Mat(240, 320, CV_8UC3, cv::Scalar(128, 128, 128))));
-    EllipseTracker tracker;
-    tracker.track_one(blank, 0, make(160, 120, 70, 45, 0.2), WindowPlacement::Projection);
-    const EllipseFeature& f = tracker.features().at(0);
-    REQUIRE(f.visible);
-    CHECK_FALSE(f.found);
-    CHECK(f.refused == EllipseRefusal::NoCandidate);
-    // Found again on the frame with the disc: the reason does not stay.
-    tracker.track_one(image, 0, make(161.5, 120, 70, 45, 0.2), WindowPlacement::Projection);
-    CHECK(tracker.features().at(0).found);
-    CHECK(tracker.features().at(0).refused == EllipseRefusal::None);
-  }
+    return f;
+  };
+  // Placed 1.5 px off: found, nothing refused.
+  const EllipseFeature& f = track(image, make(161.5, 120, 70, 45, 0.2));
+  CHECK(f.found);
+  CHECK(f.refused == EllipseRefusal::None);
+  // Placed a quarter smaller (the prediction a quarter too far): the lines find the disc's
+  // contour, whose size the prediction rules out.
+  CHECK(track(image, make(160, 120, 52.5, 33.75, 0.2)).refused == EllipseRefusal::OtherShape);
+  CHECK_FALSE(f.found);
+  CHECK(std::string(to_string(f.refused)) == "other_shape");
+  // Nothing to fit.
+  CHECK(track(blank, make(160, 120, 70, 45, 0.2)).refused == EllipseRefusal::NoCandidate);
+  CHECK_FALSE(f.found);
+  // Found again in the next frame, the disc's (no reset between): the reason does not stay.
+  tracker.track_one(image, 0, make(161.5, 120, 70, 45, 0.2), WindowPlacement::Projection);
+  CHECK(f.found);
+  CHECK(f.refused == EllipseRefusal::None);
 }
