@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "epichead/common/chi2_bounds.h"
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
 #include "epichead/fusion/vision_arbiter.h"
@@ -85,7 +86,7 @@ class ConstantVelocityPredictor final : public TrackPredictor {
 // Consistency of the vision updates: the normalised innovation squared (NIS) of a pose against
 // the filter's prediction is chi-square with 6 degrees of freedom when both covariances are
 // honest (5 for a body of revolution, whose turn is not compared: fusion/free_direction.h): mean 6
-// (5), and 95 % of the values within [1.237, 14.449] ([0.831, 12.833]).
+// (5), and 95 % of the values within common::chi2_95_bounds.
 class NisStats {
  public:
   void add(double nis, int dims) {
@@ -101,8 +102,9 @@ class NisStats {
       v.push_back(x);
       sum += x;
       dims += n;
-      below += x < (n == 5 ? kChi2Low5 : kChi2Low);
-      above += x > (n == 5 ? kChi2High5 : kChi2High);
+      const common::Chi2Bounds b = common::chi2_95_bounds(n);
+      below += x < b.low;
+      above += x > b.high;
     }
     std::sort(v.begin(), v.end());
     const double n = static_cast<double>(v.size());
@@ -116,7 +118,6 @@ class NisStats {
   }
 
  private:
-  static constexpr double kChi2Low = 1.237, kChi2High = 14.449, kChi2Low5 = 0.831, kChi2High5 = 12.833;
   std::vector<std::pair<double, int>> values_;
 };
 

@@ -3,26 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <unordered_map>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 
+#include "epichead/common/chi2_bounds.h"
+
 namespace epichead::vision {
 namespace {
 
-struct Chi2Bounds {
-  double low, high;  // 2.5 % and 97.5 % quantiles
-};
-
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-Chi2Bounds bounds(int dof) {
-  if (dof == 5) return {0.8312, 12.8325};
-  if (dof == 6) return {1.2373, 14.4494};
-  throw std::invalid_argument("pose_consistency: dof must be 5 or 6");
-}
 
 // e' C^-1 e over the whole twist, or with an axis turn u over the subspace orthogonal to u: the
 // marginal of the five directions the scoring sees, whatever turn about the axis it removed.
@@ -48,7 +39,7 @@ PoseConsistency pose_consistency(const ScoreSummary& summary, const std::vector<
   bool with_axis = false;
   for (const FrameScore& s : summary.per_frame) with_axis = with_axis || !s.axis_twist.isZero();
   const int dof = with_axis ? 5 : 6;
-  const Chi2Bounds b = bounds(dof);
+  const common::Chi2Bounds b = common::chi2_95_bounds(dof);
   std::unordered_map<int, const StampedCovariance*> by_frame;
   for (const auto& c : covariances) by_frame.emplace(c.frame, &c);
   PoseConsistency out;
