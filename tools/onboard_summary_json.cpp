@@ -8,6 +8,7 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
           {"frames", s.frames},
           {"tracked", s.tracked},
           {"lost", s.lost},
+          {"fallback_frames", s.fallback_frames},
           {"imu_samples", s.imu_samples},
           {"imu_rejected", s.imu_rejected},
           {"commands_sent", s.commands_sent},

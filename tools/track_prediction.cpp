@@ -9,6 +9,7 @@
 #include "epichead/fusion/predictor.h"
 #include "epichead/fusion/time_offset_estimator.h"
 #include "epichead/fusion/vision_arbiter.h"
+#include "epichead/vision/constant_velocity.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
 
@@ -25,61 +26,22 @@ constexpr double kUnknownOffsetSigmaS = 0.01;
 // After the estimate is adopted: its accuracy (within 1 ms in tests/fusion/test_time_offset_estimator.cpp).
 constexpr double kEstimatedOffsetSigmaS = 0.001;
 
-// Constant velocity in SE(3): the last relative motion between good poses, scaled to the
-// elapsed time and applied on the left (where camera motion acts on cam_T_obj).
+// Without the IMU: the vision poses extrapolated alone (vision/constant_velocity.h).
 class ConstantVelocityPredictor final : public TrackPredictor {
  public:
   // Starts from the given pose (init.csv) at rest.
-  ConstantVelocityPredictor(double t_s, const Eigen::Isometry3d& cam_T_obj)
-      : last_(cam_T_obj), last_tracked_(cam_T_obj), last_t_s_(t_s) {}
-  void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
-    last_ = last_tracked_ = prev_ = cam_T_obj;
-    last_t_s_ = prev_t_s_ = t_s;
-    have_motion_ = false;
-  }
-  Eigen::Isometry3d predict(double t_s) override {
-    if (!have_motion_ || !(last_t_s_ > prev_t_s_)) return last_;
-    const double s = (t_s - last_t_s_) / (last_t_s_ - prev_t_s_);
-    const Eigen::Isometry3d delta = last_ * prev_.inverse();
-    const Eigen::AngleAxisd rot(delta.rotation());
-    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-    step.linear() = Eigen::AngleAxisd(s * rot.angle(), rot.axis()).toRotationMatrix();
-    step.translation() = s * delta.translation();
-    return step * last_;
-  }
+  ConstantVelocityPredictor(double t_s, const Eigen::Isometry3d& cam_T_obj) : motion_(t_s, cam_T_obj) {}
+  void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) override { motion_.restart(t_s, cam_T_obj); }
+  Eigen::Isometry3d predict(double t_s) override { return motion_.predict(t_s); }
   void observe(double t_s, const vision::FrameReport& report) override {
-    if (report.status == vision::TrackStatus::Lost) {
-      ++lost_;
-      // Keep trying from the last pose the image fully supported (a degraded pose before the
-      // loss may be where it went wrong), without extrapolating.
-      have_motion_ = false;
-      last_ = last_tracked_;
-      return;
-    }
-    if (report.status == vision::TrackStatus::Tracked) last_tracked_ = report.cam_T_obj;
-    if (report.status == vision::TrackStatus::Degraded) {
-      // A doubtful pose (high residual, few inliers) is where the next frame starts, but no
-      // motion is extrapolated from it: one pose a few degrees off, taken as a velocity,
-      // throws the next frame's windows off the object, and each frame after it further
-      // (mockup_walk, seed 11: from 0.4 to 32 deg in three frames during a step).
-      last_ = report.cam_T_obj;
-      last_t_s_ = t_s;
-      have_motion_ = false;
-      return;
-    }
-    prev_ = last_;
-    prev_t_s_ = last_t_s_;
-    have_motion_ = true;
-    last_ = report.cam_T_obj;
-    last_t_s_ = t_s;
+    lost_ += report.status == vision::TrackStatus::Lost;
+    motion_.observe(t_s, report.status, report.cam_T_obj);
   }
   std::optional<Eigen::Isometry3d> fused(double) override { return std::nullopt; }
   nlohmann::json diagnostics() const override { return {{"model", "constant_velocity"}, {"lost_frames", lost_}}; }
 
  private:
-  Eigen::Isometry3d last_, last_tracked_, prev_ = Eigen::Isometry3d::Identity();
-  double last_t_s_ = 0, prev_t_s_ = 0;
-  bool have_motion_ = false;
+  vision::ConstantVelocity motion_;
   int lost_ = 0;
 };
 
@@ -163,7 +125,7 @@ class ImuPredictor final : public TrackPredictor {
     ++detection_restarts_;
   }
   void observe(double t_s, const vision::FrameReport& report) override {
-    vision_only_.observe(t_s, report);
+    vision_only_.observe(t_s, report.status, report.cam_T_obj);
     verdict_ = nullptr;
     if (report.status == vision::TrackStatus::Lost) {
       ++lost_;
@@ -362,7 +324,7 @@ class ImuPredictor final : public TrackPredictor {
   int weak_reacquisitions_ = 0, detection_restarts_ = 0;
   fusion::VisionArbiter arbiter_;  // who is wrong when vision and the filter disagree
   nlohmann::json verdict_;  // frame_verdict()
-  ConstantVelocityPredictor vision_only_;  // the second opinion when the IMU's prediction loses the object
+  vision::ConstantVelocity vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).
   static constexpr double kEstimatorLeadS = 0.15;

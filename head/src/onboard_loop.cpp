@@ -13,6 +13,7 @@
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/protocol.h"
 #include "epichead/head/target_observation.h"
+#include "epichead/vision/constant_velocity.h"
 #include "epichead/vision/model_centre.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
@@ -65,6 +66,10 @@ struct OnboardLoop::Impl {
 
   // Initial pose and the last good one: where windows go while the predictor has nothing.
   Eigen::Isometry3d last_good = Eigen::Isometry3d::Identity();
+  // The vision poses extrapolated alone: the tracker's second opinion when the predictor's pose
+  // finds nothing usable (the filter has left the object), as in `track`; the arbiter then
+  // restarts the filter from a pose so found that the image supports well.
+  vision::ConstantVelocity vision_only{0.0, Eigen::Isometry3d::Identity()};
   double init_t_s = 0;
   bool init_pending = false;
   bool have_pose = false;  // a start pose was given or detected
@@ -173,6 +178,8 @@ struct OnboardLoop::Impl {
     job.exposure_t_s = exposure;
     job.taken_t_s = now_s;
     job.predicted = prediction ? prediction->cam_T_obj : last_good;
+    job.fallback.reset();
+    if (prediction && have_pose) job.fallback = vision_only.predict(exposure);
     // No start yet, or lost for a few frames: the stage looks for the object instead.
     job.detect = detector && (!have_pose || lost_run >= options.lost_frames_before_detection);
     job.detect_near = job.orient_like_predicted = job.detect && have_pose;
@@ -219,6 +226,7 @@ struct OnboardLoop::Impl {
       ++summary.against_gravity;
     }
     (status == vision::TrackStatus::Lost ? summary.lost : summary.tracked) += 1;
+    summary.fallback_frames += !r->detection && report.used_fallback;
     // Inline: at the modelled time the stage set; Thread: now, when the control thread takes it.
     const double published = options.threads == VisionThreads::Inline ? r->done_t_s : now_s;
     const double latency_ms = 1e3 * (published - r->exposure_t_s);
@@ -232,6 +240,7 @@ struct OnboardLoop::Impl {
       predictor.reset();
       arbiter.clear();
       last_good = report.cam_T_obj;
+      vision_only.restart(r->exposure_t_s, report.cam_T_obj);
       init_t_s = r->exposure_t_s;
       init_pending = true;
       have_pose = true;
@@ -241,6 +250,7 @@ struct OnboardLoop::Impl {
       vision.release();
       return;
     }
+    if (!r->detection) vision_only.observe(r->exposure_t_s, status, report.cam_T_obj);
     if (status != vision::TrackStatus::Lost) {  // else the controller's watchdog sees the target go stale
       last_good = report.cam_T_obj;
       // Vision and the filter disagree: the arbiter decides which is wrong, as `track` does.
@@ -407,6 +417,7 @@ void OnboardLoop::request_stop() { impl_->stop_requested.store(true, std::memory
 
 void OnboardLoop::set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_obj) {
   impl_->last_good = cam_T_obj;
+  impl_->vision_only.restart(t_s, cam_T_obj);
   impl_->init_t_s = t_s;
   impl_->init_pending = true;
   impl_->have_pose = true;

@@ -74,7 +74,7 @@ void VisionStage::track_job() {
   result_.found = false;
   result_.levelled = false;
   if (result_.readable && result_.detection) detect_job(mat);
-  else if (result_.readable) tracker_.track(image_, job_.predicted, report_);
+  else if (result_.readable) tracker_.track(image_, job_.predicted, job_.fallback ? &*job_.fallback : nullptr, report_);
   result_.track_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -39,6 +39,9 @@ struct VisionJob {
   std::uint64_t index = 0;
   double exposure_t_s = 0, taken_t_s = 0;  // the frame's exposure; when the loop took it
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
+  // The second opinion measured when nothing usable is found from `predicted` (the vision poses
+  // extrapolated alone; ModelTracker::track's fallback), or none.
+  std::optional<Eigen::Isometry3d> fallback;
   hw::CameraFrame frame;                   // data points into the stage's own copy of the bytes
   // Find the object instead of tracking it (the stage's detector): near `predicted` first when
   // detect_near, else over the whole search. orient_like_predicted: of the poses a symmetric

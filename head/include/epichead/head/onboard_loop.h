@@ -104,6 +104,9 @@ using FrameHook = std::function<void(const TrackedFrame&)>;
 struct OnboardSummary {
   std::uint64_t ticks = 0, late_ticks = 0;       // control ticks; ticks started more than a period late
   std::uint64_t frames = 0, tracked = 0, lost = 0;
+  // Frames measured from the vision poses extrapolated alone, the predictor's pose having given
+  // nothing usable (ModelTracker::track's fallback; `track` counts them as fallback_frames).
+  std::uint64_t fallback_frames = 0;
   std::uint64_t imu_samples = 0, imu_rejected = 0;
   std::uint64_t commands_sent = 0, commands_withheld = 0, send_failures = 0;
   std::uint64_t bus_errors = 0, frames_logged = 0, unknown_frames = 0, undecodable_frames = 0;
