@@ -22,6 +22,18 @@ using epichead::testing::lines_of;
 using epichead::testing::slurp;
 using epichead::testing::TempDir;
 
+namespace {
+
+// summary.json of `sim-run ARGS --every 0 --out DIR/out`, which must succeed.
+nlohmann::json sim_run_summary(const TempDir& dir, const std::string& args) {
+  const auto r = run_epichead(dir, "sim-run " + args + " --every 0 --out '" + dir.str() + "/out'");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  return nlohmann::json::parse(slurp(dir / "out/summary.json"));
+}
+
+}  // namespace
+
 TEST_CASE("sim-run: the stabilised camera turns several times slower than with the head fixed, the log replays",
           "[tools][sim-run]") {
   TempDir dir("sim_run");
@@ -287,10 +299,7 @@ TEST_CASE("sim-run: gated poses that agree restart the predictor, as in track (f
   // box_clutter, seed 2: at 1.7-1.8 s the predictor gates three poses that agree with each other;
   // the third restarts it from vision. Without the arbiter the filter gated 8 poses by 2 s and
   // re-initialised itself once.
-  const auto r = run_epichead(dir, "sim-run box_clutter --seed 2 --seconds 2 --every 0 --out '" + dir.str() + "/out'");
-  INFO(r.out << r.err);
-  REQUIRE(r.exit_code == 0);
-  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  const auto j = sim_run_summary(dir, "box_clutter --seed 2 --seconds 2");
   const auto& p = j["loop"]["predictor"];
   INFO(p.dump());
   CHECK(p["restarts_after_agreeing_gated"].get<int>() == 1);
@@ -305,10 +314,7 @@ TEST_CASE("sim-run: a frame the predictor's pose loses is measured again from th
   // can, seed 2: past 7 s the predictor's pose leaves the can on a frame where the vision poses'
   // own extrapolation still finds it. Without that second opinion (before 2026-12-07) the loop
   // tracked 91.1 % of the first 7.5 s; with it 96.1 %, from one frame so measured.
-  const auto r = run_epichead(dir, "sim-run can --seed 2 --seconds 7.5 --every 0 --out '" + dir.str() + "/out'");
-  INFO(r.out << r.err);
-  REQUIRE(r.exit_code == 0);
-  const auto j = nlohmann::json::parse(slurp(dir / "out/summary.json"));
+  const auto j = sim_run_summary(dir, "can --seed 2 --seconds 7.5");
   INFO(j["loop"].dump());
   CHECK(j["loop"]["fallback_frames"].get<int>() >= 1);
   CHECK(j["tracking_success"].get<double>() >= 0.95);
