@@ -300,6 +300,9 @@ class ImuPredictor final : public TrackPredictor {
     p->carry_learnt_gravity(predictor_);
     p->carry_counters(predictor_);
     predictor_ = std::move(*p);
+    // The gated poses the arbiter holds were measured against the filter on the old clock, as
+    // after a loss's reset or a detection's restart (vision_arbiter.h: clear()).
+    arbiter_.clear();
     const auto& imu = *imu_;
     next_ = 0;
     while (next_ < imu.size() && imu[next_].t_s - offset_s_ < t_s - options_.gravity_average_s - 0.05) ++next_;
