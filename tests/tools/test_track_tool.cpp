@@ -25,16 +25,21 @@ using epichead::testing::TempDir;
 namespace {
 namespace fs = std::filesystem;
 const auto& q = epichead::testing::shell_quoted;
+
+// report.json of `track SEQ --out OUT ARGS`, which must succeed.
+nlohmann::json track_report(const TempDir& tmp, const std::string& seq, const std::string& out, const std::string& args) {
+  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " " + args);
+  INFO(run.err);
+  REQUIRE(run.exit_code == 0);
+  return nlohmann::json::parse(slurp(out + "/report.json"));
+}
 }  // namespace
 
 TEST_CASE("track follows a short simulated mockup_walk with epic+validation and writes every output") {
   TempDir tmp("epichead_test_track_tool");
   const std::string seq = tmp / "mockup_walk", out = tmp / "track";
   REQUIRE(run_epichead(tmp, "sim mockup_walk --out " + q(seq) + " --frames 40").exit_code == 0);
-  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 20");
-  INFO(run.err);
-  REQUIRE(run.exit_code == 0);
-  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto report = track_report(tmp, seq, out, "--every 20");
   CHECK(report["frames"] == 40);
   CHECK(report["tracked"].get<int>() + report["lost"].get<int>() == 40);
   // The issue's target (>= 99 % on mockup_walk at the default jerk) is measured on the full
@@ -82,10 +87,7 @@ TEST_CASE("track's report says which start a start frame kept and why a rim was 
   TempDir tmp("epichead_test_track_start_report");
   const std::string seq = tmp / "can", out = tmp / "track";
   REQUIRE(run_epichead(tmp, "sim can --out " + q(seq) + " --frames 8").exit_code == 0);
-  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --every 0 --no-video");
-  INFO(run.err);
-  REQUIRE(run.exit_code == 0);
-  const auto frames = nlohmann::json::parse(slurp(out + "/report.json"))["per_frame"];
+  const auto frames = track_report(tmp, seq, out, "--every 0 --no-video")["per_frame"];
   REQUIRE(frames.size() == 8);
   // Frame 0 is a start from init.csv: the settle's choice and both supports.
   const auto& start = frames[0]["start"];
@@ -164,11 +166,7 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   REQUIRE(run_epichead(tmp, "sim box_clutter --out " + q(seq) + " --frames 75 --jerk 2").exit_code == 0);
   const auto truth = nlohmann::json::parse(slurp(seq + "/sim_truth.json"));
   const std::string offset = std::to_string(truth["imu"]["clock_offset_s"].get<double>());
-  const auto run = run_epichead(tmp, "track " + q(seq) + " --out " + q(out) + " --imu on --imu-time-offset-s " + offset +
-                                         " --every 0 --no-video");
-  INFO(run.err);
-  REQUIRE(run.exit_code == 0);
-  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto report = track_report(tmp, seq, out, "--imu on --imu-time-offset-s " + offset + " --every 0 --no-video");
   CHECK(report["fused_frames"].get<int>() == 75 - report["lost"].get<int>());
   auto score = [&](const std::string& poses) {
     const auto r = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/" + poses) + " --json");
@@ -254,10 +252,7 @@ TEST_CASE("track without the IMU follows a hand-held burst by the frame's own mo
 TEST_CASE("track follows the real teabox video to within a few pixels of the hand-read corners") {
   TempDir tmp("epichead_test_track_tool");
   const std::string data = std::string(EPICHEAD_SHARED_DATA) + "/teabox", out = tmp / "teabox";
-  const auto run = run_epichead(tmp, "track " + q(data) + " --out " + q(out) + " --every 0 --no-video");
-  INFO(run.err);
-  REQUIRE(run.exit_code == 0);
-  const auto report = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto report = track_report(tmp, data, out, "--every 0 --no-video");
   CHECK(report["lost"] == 0);
   const auto score = run_epichead(tmp, "score " + q(data) + " " + q(out + "/poses.csv") + " --json --reference " +
                                            q(data + "/reference_visp.csv") + " --corners 0:" +
