@@ -66,7 +66,9 @@ struct SimRunArgs {
   double soak_warmup_s = 60;
   std::string threads = "simulated";  // simulated (deterministic) | wall (vision on its own thread, as on the robot)
   bool no_init = false;    // no start pose: detection finds the object
-  bool reacquire = false;  // detection after a loss (always with no_init)
+  // Detection after a loss, as `run` does by default: on with the full-size camera in a mode that
+  // tracks (fixate, hold), unless --no-reacquire; --reacquire asks for it (and fails when downscaled).
+  bool reacquire = false, no_reacquire = false;
   DetectionArgs detection;
   std::optional<Eigen::Vector3d> object_up_obj;  // detection.object_up, read
   // Where simulated time 0 lands in bus.log (Unix seconds, or "now"): a fixed date by default, so
@@ -257,6 +259,13 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
   ++m.frames;
 }
 
+// Whether detection runs: always without a start pose; after a loss when asked, or by default
+// (as `run`) with the full-size camera the templates are made for, in a mode that tracks.
+bool reacquires(const SimRunArgs& a) {
+  if (a.no_init || a.reacquire) return true;
+  return !a.no_reacquire && a.downscale == 1 && a.mode != "stabilise";
+}
+
 // Where one run's frames go on the progress line: the runs one after the other.
 struct RunProgress {
   Progress& line;
@@ -424,10 +433,11 @@ int run_sim_run(const SimRunArgs& given) {
   fs::create_directories(a.out, ec);
   if (ec) return fail(cmd, "cannot create " + a.out + ": " + ec.message());
 
-  // Detection (--no-init, --reacquire) for the rendered run: the templates are built (or read)
+  // Detection (--no-init, re-acquisition) for the rendered run: the templates are built (or read)
   // before the simulated time starts.
+  const bool reacquiring = reacquires(a);
   std::unique_ptr<vision::Detector> detector;
-  if (a.no_init || a.reacquire) {
+  if (reacquiring) {
     auto model = sim::make_scene_model(scenario->scene);
     if (!model) return fail(cmd, model.error());
     auto camera = sim::scenario_camera(*scenario);
@@ -471,6 +481,7 @@ int run_sim_run(const SimRunArgs& given) {
                    {"seed", scenario->seed},
                    {"processing_ms", a.processing_ms},
                    {"threads", a.threads},
+                   {"reacquire", reacquiring},
                    {"tracking_success", success},
                    {"frames", closed.frames},
                    {"hidden_frames", closed.hidden},
@@ -511,6 +522,12 @@ int run_sim_run(const SimRunArgs& given) {
               static_cast<unsigned long long>(scenario->seed), closed.frames, 100 * success);
   if (closed.hidden > 0) std::printf(" (%d frames with the object hidden by a cover left out)", closed.hidden);
   std::printf("\n");
+  if (reacquiring)
+    std::printf("  re-acquisition on: %llu losses, %llu found again by detection\n",
+                static_cast<unsigned long long>(run->losses), static_cast<unsigned long long>(run->reacquisitions));
+  else
+    std::printf("  re-acquisition off (%s): after a loss the tracker retries from its last pose only\n",
+                a.no_reacquire ? "--no-reacquire" : a.downscale != 1 ? "detection needs --downscale 1" : "mode stabilise");
   std::printf("  camera rate RMS (x,y, after %.1f s): %.2f deg/s stabilised vs %.2f deg/s head fixed (%.1fx lower)",
               a.settle_s, stabilised.cam_rate_rms_degps, fixed.cam_rate_rms_degps, reduction);
   if (fixating) std::printf("; %.2f deg/s while fixating", closed.cam_rate_rms_degps);
@@ -553,7 +570,11 @@ const CommandRegistration registration{
           ->check(CLI::Range(0.0, 1e6));
       app.add_flag("--no-init", a->no_init,
                    "Give the loop no start pose: detection finds the object (and finds it again after a loss)");
-      app.add_flag("--reacquire", a->reacquire, "Detection finds the object again after a loss");
+      auto* on = app.add_flag("--reacquire", a->reacquire,
+                              "Detection finds the object again after a loss (the default with the full-size camera "
+                              "and a mode that tracks, as `run` does; an error with --downscale above 1)");
+      app.add_flag("--no-reacquire", a->no_reacquire, "After a loss retry from the last pose only (no detection)")
+          ->excludes(on);
       app.add_option("--log-epoch", a->log_epoch,
                      "Unix time (s) at which simulated time 0 is written in bus.log, as candump stamps on the wall "
                      "clock (default 1704067200, 2024-01-01T00:00:00Z, so a seed gives the same log; 'now': the "

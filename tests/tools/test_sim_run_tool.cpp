@@ -299,7 +299,8 @@ TEST_CASE("sim-run: gated poses that agree restart the predictor, as in track (f
   // box_clutter, seed 2: at 1.7-1.8 s the predictor gates three poses that agree with each other;
   // the third restarts it from vision. Without the arbiter the filter gated 8 poses by 2 s and
   // re-initialised itself once.
-  const auto j = sim_run_summary(dir, "box_clutter --seed 2 --seconds 2");
+  // No re-acquisition: nothing is lost in these 2 s, and its templates need not be built here.
+  const auto j = sim_run_summary(dir, "box_clutter --seed 2 --seconds 2 --no-reacquire");
   const auto& p = j["loop"]["predictor"];
   INFO(p.dump());
   CHECK(p["restarts_after_agreeing_gated"].get<int>() == 1);
@@ -314,10 +315,49 @@ TEST_CASE("sim-run: a frame the predictor's pose loses is measured again from th
   // can, seed 2: past 7 s the predictor's pose leaves the can on a frame where the vision poses'
   // own extrapolation still finds it. Without that second opinion (before 2026-12-07) the loop
   // tracked 91.1 % of the first 7.5 s; with it 96.1 %, from one frame so measured.
-  const auto j = sim_run_summary(dir, "can --seed 2 --seconds 7.5");
+  // As measured then, without re-acquisition (the can's templates are not built here).
+  const auto j = sim_run_summary(dir, "can --seed 2 --seconds 7.5 --no-reacquire");
   INFO(j["loop"].dump());
   CHECK(j["loop"]["fallback_frames"].get<int>() >= 1);
   CHECK(j["tracking_success"].get<double>() >= 0.95);
+}
+
+TEST_CASE("sim-run finds the object again by detection after a loss by default as run does, and not when told not to or downscaled",
+          "[tools][sim-run]") {
+  TempDir dir("sim_run_reacquire");
+  // box_cover: a board hides the package from 2.5 to 3.5 s. The templates (--views 1, the
+  // simulator's camera) are the ones the "package templates" fixture put in the test cache.
+  const auto r = run_epichead(dir, "sim-run box_cover --seconds 4.5 --views 1 --every 0 --out '" + dir.str() + "/on'");
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto on = nlohmann::json::parse(slurp(dir / "on/summary.json"));
+  const auto& acq = on["loop"]["deadlines"]["acquisition"];
+  INFO(acq.dump());
+  CHECK(on["reacquire"] == true);
+  CHECK(acq["losses"].get<int>() >= 1);
+  CHECK(acq["detections"].get<int>() >= 1);
+  CHECK(acq["reacquisitions"].get<int>() >= 1);
+  CHECK(r.out.find("re-acquisition on: ") != std::string::npos);
+  CHECK(on["tracking_success"].get<double>() >= 0.95);
+
+  // Told not to, or with a camera smaller than the templates': no detection, and the line says why.
+  for (const auto& [flags, why] : {std::pair<std::string, std::string>{"--no-reacquire", "--no-reacquire"},
+                                   {"--downscale 2", "detection needs --downscale 1"}}) {
+    const auto off = run_epichead(dir, "sim-run box_cover --seconds 0.5 --every 0 " + flags + " --out '" + dir.str() + "/off'");
+    INFO(off.out << off.err);
+    REQUIRE(off.exit_code == 0);
+    const auto j = nlohmann::json::parse(slurp(dir / "off/summary.json"));
+    CHECK(j["reacquire"] == false);
+    CHECK(j["loop"]["deadlines"]["acquisition"]["detections"] == 0);
+    CHECK(off.out.find("re-acquisition off (" + why + ")") != std::string::npos);
+  }
+  // Asked for with a downscaled camera: an error naming why, before anything runs.
+  const auto bad = run_epichead(dir, "sim-run box_cover --seconds 0.5 --reacquire --downscale 2 --out '" + dir.str() + "/bad'");
+  CHECK(bad.exit_code == 1);
+  CHECK(bad.err.find("need the full-size camera (--downscale 1)") != std::string::npos);
+  const auto both = run_epichead(dir, "sim-run box_cover --reacquire --no-reacquire --out '" + dir.str() + "/both'");
+  CHECK(both.exit_code != 0);
+  CHECK(both.err.find("--reacquire excludes --no-reacquire") != std::string::npos);
 }
 
 TEST_CASE("timeline.csv's header is the list of columns README.md documents, each named with its unit") {
