@@ -260,6 +260,26 @@ TEST_CASE("sim-run --soak: after a bus-off inside a step's burst no tilted lock 
   CHECK(run.tracked_off_10deg_after_fault == 0);
 }
 
+// The onboard loop's own wiring of the tilt check (the check itself: tests/fusion/
+// test_learnt_gravity.cpp), which the bus-off run above no longer reaches: told an up the poses
+// contradict (the mockup stands with its model's z up, told x), the loop refuses every tracked
+// pose as against gravity and counts the frame lost; told the right up, it refuses none.
+TEST_CASE("sim-run: the onboard loop takes a tracked pose whose tilt contradicts the told up as lost, and counts it", "[tools][sim-run]") {
+  TempDir dir("sim_run_against_gravity");
+  const auto wrong = sim_run_summary(dir, "mockup_walk --seconds 1 --object-up 1,0,0 --no-reacquire");
+  INFO(wrong["loop"].dump());
+  const int frames = wrong["frames"].get<int>();
+  REQUIRE(frames >= 20);
+  CHECK(wrong["loop"]["deadlines"]["acquisition"]["against_gravity"].get<int>() == frames);
+  CHECK(wrong["loop"]["predictor"]["vision_against_gravity"].get<int>() == frames);
+  CHECK(wrong["loop"]["tracked"].get<int>() == 0);
+  CHECK(wrong["tracking_success"].get<double>() == 0.0);
+  const auto right = sim_run_summary(dir, "mockup_walk --seconds 1 --object-up 0,0,1 --no-reacquire");
+  INFO(right["loop"].dump());
+  CHECK(right["loop"]["deadlines"]["acquisition"]["against_gravity"].get<int>() == 0);
+  CHECK(right["tracking_success"].get<double>() >= 0.99);
+}
+
 // Coming back (issue 22 item 5). Without vision the filter's tilt is updated from the
 // accelerometer and its position held near the last one vision verified (fusion/unaided_update.h),
 // and over the gap it no longer integrates the last reading's acceleration: the prediction is
