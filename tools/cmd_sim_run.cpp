@@ -568,13 +568,14 @@ const CommandRegistration registration{
           ->check(CLI::IsMember({"simulated", "wall"}));
       app.add_option("--settle-s", a->settle_s, "Leave the first S seconds (the first slew) out of the rate RMS (default 2)")
           ->check(CLI::Range(0.0, 1e6));
-      app.add_flag("--no-init", a->no_init,
-                   "Give the loop no start pose: detection finds the object (and finds it again after a loss)");
+      auto* no_init = app.add_flag("--no-init", a->no_init,
+                                   "Give the loop no start pose: detection finds the object (and finds it again after a loss)");
       auto* on = app.add_flag("--reacquire", a->reacquire,
                               "Detection finds the object again after a loss (the default with the full-size camera "
                               "and a mode that tracks, as `run` does; an error with --downscale above 1)");
       app.add_flag("--no-reacquire", a->no_reacquire, "After a loss retry from the last pose only (no detection)")
-          ->excludes(on);
+          ->excludes(on)
+          ->excludes(no_init);
       app.add_option("--log-epoch", a->log_epoch,
                      "Unix time (s) at which simulated time 0 is written in bus.log, as candump stamps on the wall "
                      "clock (default 1704067200, 2024-01-01T00:00:00Z, so a seed gives the same log; 'now': the "

@@ -378,6 +378,11 @@ TEST_CASE("sim-run finds the object again by detection after a loss by default a
   const auto both = run_epichead(dir, "sim-run box_cover --reacquire --no-reacquire --out '" + dir.str() + "/both'");
   CHECK(both.exit_code != 0);
   CHECK(both.err.find("--reacquire excludes --no-reacquire") != std::string::npos);
+  // Without a start pose the loop detects, after a loss too: --no-reacquire cannot hold then.
+  const auto no_init = run_epichead(dir, "sim-run box_cover --no-init --no-reacquire --out '" + dir.str() + "/no_init'");
+  CHECK(no_init.exit_code != 0);
+  CHECK(no_init.err.find("excludes") != std::string::npos);
+  CHECK(no_init.err.find("--no-init") != std::string::npos);
 }
 
 TEST_CASE("timeline.csv's header is the list of columns README.md documents, each named with its unit") {
