@@ -535,7 +535,7 @@ int run_sim_run(const SimRunArgs& given) {
   std::printf("  target from image centre: %.1f px RMS (max %.1f) vs %.1f px RMS head fixed\n", closed.centring_rms_px,
               closed.centring_max_px, fixed.centring_rms_px);
   std::printf("  control loop: %llu ticks (%llu late), work %.1f us median / %.1f us p99 / %.1f us max per tick on the "
-              "control thread (wall, vision and rendering excluded); %llu frames dropped while vision was busy\n",
+              "control thread (wall; vision, rendering and the overlays excluded); %llu frames dropped while vision was busy\n",
               static_cast<unsigned long long>(run->ticks), static_cast<unsigned long long>(run->late_ticks),
               run->tick_work_us_median, run->tick_work_us_p99, run->tick_work_us_max,
               static_cast<unsigned long long>(run->frames_dropped_vision_busy));
