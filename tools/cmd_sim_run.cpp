@@ -259,11 +259,15 @@ void measure_frame(const head::TrackedFrame& f, sim::SimWorld& w, const SimRunAr
   ++m.frames;
 }
 
-// Whether detection runs: always without a start pose; after a loss when asked, or by default
-// (as `run`) with the full-size camera the templates are made for, in a mode that tracks.
-bool reacquires(const SimRunArgs& a) {
-  if (a.no_init || a.reacquire) return true;
-  return !a.no_reacquire && a.downscale == 1 && a.mode != "stabilise";
+// Why detection does not run, or nullptr when it does: always without a start pose; after a loss
+// when asked, or by default (as `run`) with the full-size camera the templates are made for, in a
+// mode that tracks.
+const char* why_no_reacquisition(const SimRunArgs& a, head::ControlMode mode) {
+  if (a.no_init || a.reacquire) return nullptr;
+  if (a.no_reacquire) return "--no-reacquire";
+  if (a.downscale != 1) return "detection needs --downscale 1";
+  if (mode == head::ControlMode::Stabilise) return "mode stabilise";
+  return nullptr;
 }
 
 // Where one run's frames go on the progress line: the runs one after the other.
@@ -435,7 +439,8 @@ int run_sim_run(const SimRunArgs& given) {
 
   // Detection (--no-init, re-acquisition) for the rendered run: the templates are built (or read)
   // before the simulated time starts.
-  const bool reacquiring = reacquires(a);
+  const char* const no_reacquisition = why_no_reacquisition(a, mode->second);
+  const bool reacquiring = no_reacquisition == nullptr;
   std::unique_ptr<vision::Detector> detector;
   if (reacquiring) {
     auto model = sim::make_scene_model(scenario->scene);
@@ -526,8 +531,7 @@ int run_sim_run(const SimRunArgs& given) {
     std::printf("  re-acquisition on: %llu losses, %llu found again by detection\n",
                 static_cast<unsigned long long>(run->losses), static_cast<unsigned long long>(run->reacquisitions));
   else
-    std::printf("  re-acquisition off (%s): after a loss the tracker retries from its last pose only\n",
-                a.no_reacquire ? "--no-reacquire" : a.downscale != 1 ? "detection needs --downscale 1" : "mode stabilise");
+    std::printf("  re-acquisition off (%s): after a loss the tracker retries from its last pose only\n", no_reacquisition);
   std::printf("  camera rate RMS (x,y, after %.1f s): %.2f deg/s stabilised vs %.2f deg/s head fixed (%.1fx lower)",
               a.settle_s, stabilised.cam_rate_rms_degps, fixed.cam_rate_rms_degps, reduction);
   if (fixating) std::printf("; %.2f deg/s while fixating", closed.cam_rate_rms_degps);
