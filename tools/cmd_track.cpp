@@ -308,6 +308,20 @@ struct TrackCounts {
   int against_image_motion = 0;  // tracked poses that contradicted the frame's motion, measured again
 };
 
+// The tracked pose's tilt against the accelerometer's down, for report.json (measured before the
+// check may mark the frame lost). A pose that tilts the object away from that down is a wrong lock
+// (a printed band, clutter), however well the image supports it: lost, so that detection runs.
+std::optional<double> check_tilt(TrackPredictor& predictor, double t_s, FrameReport& report, TrackCounts& counts) {
+  if (report.status == TrackStatus::Lost) return std::nullopt;
+  const std::optional<double> error_rad = predictor.tilt_error_rad(t_s, report.cam_T_obj);
+  if (predictor.against_gravity(t_s, error_rad)) {
+    report.status = TrackStatus::Lost;
+    report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
+    ++counts.against_gravity;
+  }
+  return error_rad;
+}
+
 // report.json's summary (per-frame entries and acquisition are added by the caller).
 nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const TrackCounts& c, const std::vector<double>& track_ms,
                            const TrackPredictor* predictor, const ModelTracker& tracker) {
@@ -430,22 +444,27 @@ int run_track(const TrackArgs& args) {
       }
     }
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
-    // The tracked pose's tilt against the accelerometer's down, for report.json and the check
-    // below (measured before the check may mark the frame lost).
-    const std::optional<double> tilt_error_rad =
-        report.status != TrackStatus::Lost ? (*predictor)->tilt_error_rad(entry.t_s, report.cam_T_obj) : std::nullopt;
-    // A pose that tilts the object away from the down the accelerometer measures is a wrong lock
-    // (a printed band, clutter), however well the image supports it: lost, so that detection runs.
-    if (report.status != TrackStatus::Lost && (*predictor)->against_gravity(entry.t_s, tilt_error_rad)) {
-      report.status = TrackStatus::Lost;
-      report.reasons = report.reasons | vision::TrackReason::AgainstGravity;
-      ++counts.against_gravity;
-    }
+    std::optional<double> tilt_error_rad = check_tilt(**predictor, entry.t_s, report, counts);
     if (use_image_motion) counts.against_image_motion += image_motion.check(tracker, image, report);
     if (auto ok = acquisition.after_tracking(*frame, image, entry.t_s, predicted, tracker, **predictor, report); !ok)
       return fail(cmd, ok.error());
     counts.fallback_frames += report.used_fallback;
     (*predictor)->observe(entry.t_s, report);
+    bool switch_undone = false;
+    if (auto before = acquisition.after_verdict(entry.t_s, (*predictor)->verdict())) {
+      // The filter gated every pose after a recheck's switch: the frame is measured again from the
+      // filter as it was before the switch, propagated to now (tools/switch_probation.h). The
+      // image's motion (without the IMU) does not run here: the filter that judges is the IMU's.
+      *predictor = std::move(before);
+      tracker.reset();
+      predicted = (*predictor)->predict(entry.t_s);
+      fallback = (*predictor)->fallback(entry.t_s);
+      tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
+      tilt_error_rad = check_tilt(**predictor, entry.t_s, report, counts);
+      counts.fallback_frames += report.used_fallback;
+      (*predictor)->observe(entry.t_s, report);
+      switch_undone = true;
+    }
     if (use_image_motion) image_motion.tracked(report.status != TrackStatus::Lost ? std::optional(report.cam_T_obj) : std::nullopt);
     track_ms.push_back(report.times.total_ms);
     counts.tracked += report.status == TrackStatus::Tracked;
@@ -487,6 +506,7 @@ int run_track(const TrackArgs& args) {
     if (use_image_motion) per_frame.back()["image_motion"] = image_motion.frame_json();
     if (tilt_error_rad) per_frame.back()["tilt_error_deg"] = *tilt_error_rad * 180 / std::numbers::pi;
     if (auto filter = (*predictor)->frame_verdict(); !filter.is_null()) per_frame.back()["filter"] = std::move(filter);
+    if (switch_undone) per_frame.back()["switch_undone"] = true;
 
     write_selected_lines(lines_csv, tracker, report, entry.frame, selected);
 

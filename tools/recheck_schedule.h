@@ -59,6 +59,8 @@ class RecheckSchedule {
     next_s_ = t_s + options_.recheck_interval_s;
     return true;
   }
+  // No more rechecks in the stretch under way (a doubtful frame inside it starts none either).
+  void quiet() { next_s_ = INFINITY; }
   int started_after_doubt() const { return after_doubt_; }
 
  private:

@@ -24,7 +24,7 @@ RecheckOptions recheck_options(const AcquisitionOptions& o) {
 TrackAcquisition::TrackAcquisition(const vision::Sequence& seq, const vision::ModelTrackerOptions& tracking,
                                    const AcquisitionOptions& options)
     : seq_(&seq), tracking_(tracking), options_(options), rechecks_due_(recheck_options(options)),
-      switch_(options.switching),
+      switch_(options.switching), probation_(options.probation),
       centre_obj_(vision::model_centre(seq.model())) {
   if (auto up = object_up(options.detection); up) up_obj_ = *up;
 }
@@ -62,6 +62,8 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::d
 void TrackAcquisition::took_detected(double t_s) {
   rechecks_due_.found_at(t_s);
   switch_.forget();
+  probation_.end();
+  before_switch_.reset();
   last_doubt_t_s_ = t_s;
 }
 
@@ -190,7 +192,11 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   // 50 frames from the start). A down learnt before the lock can have begun is kept: on stumble's
   // development seed 1 with the IMU a switch's detected pose, after the jolt, was itself tilted
   // more than 10 deg from a down learnt in the second before it.
-  if (switched) predictor.replace_wrong_lock(t_s, *found, lock_since_s);
+  if (switched) {
+    before_switch_ = predictor.clone();
+    probation_.begin(t_s);
+    predictor.replace_wrong_lock(t_s, *found, lock_since_s);
+  }
   // With the IMU and the object's down learnt, the tilt is gravity's, not the outline's.
   if (const auto up = predictor.upright(t_s)) {
     found = geometry::level_to_up(*found, up->up_obj, up->up_cam, centre_obj_);
@@ -201,6 +207,25 @@ std::expected<void, std::string> TrackAcquisition::after_tracking(const cv::Mat&
   tracker.track(image, *found, report);
   report.reasons = report.reasons | vision::TrackReason::Reacquired;
   return {};
+}
+
+std::unique_ptr<TrackPredictor> TrackAcquisition::after_verdict(double t_s, std::optional<fusion::VisionVerdict> verdict) {
+  const bool gated = verdict == fusion::VisionVerdict::Gated;
+  const bool judged = gated || verdict == fusion::VisionVerdict::Applied;
+  const SwitchProbation::Decision d = probation_.judge(t_s, judged, gated);
+  if (d == SwitchProbation::Decision::None) return nullptr;
+  std::unique_ptr<TrackPredictor> before = std::move(before_switch_);
+  if (d == SwitchProbation::Decision::Stands) return nullptr;
+  ++switches_undone_;
+  for (auto it = recheck_log_.rbegin(); it != recheck_log_.rend(); ++it)
+    if (it->value("switched", false)) {
+      (*it)["undone_t_s"] = t_s;
+      break;
+    }
+  // The filter vouched for the pose tracked before against the one found: the search would find
+  // that one again on the next rechecks.
+  rechecks_due_.quiet();
+  return before;
 }
 
 nlohmann::json TrackAcquisition::to_json() const {
@@ -216,6 +241,7 @@ nlohmann::json TrackAcquisition::to_json() const {
                       {"recheck_stretches_after_doubt", rechecks_due_.started_after_doubt()},
                       {"levelled_to_gravity", levelled_},
                       {"switches", switches_},
+                      {"switches_undone", switches_undone_},
                       {"recheck_log", recheck_log_},
                       {"detect_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},
                       {"detect_ms_max", ms.empty() ? 0.0 : ms.back()}};

@@ -16,6 +16,7 @@
 #include "detection_setup.h"
 #include "recheck_schedule.h"
 #include "recheck_switch.h"
+#include "switch_probation.h"
 #include "track_prediction.h"
 #include "epichead/vision/detector.h"
 #include "epichead/vision/model_tracker.h"
@@ -35,6 +36,9 @@ struct AcquisitionOptions {
   // view (late_entry).
   RecheckOptions recheck;
   SwitchOptions switching;
+  // With the IMU, a switch stands once the filter started from it applies a pose, and is undone
+  // when it gates the first few (switch_probation.h).
+  ProbationOptions probation;
 };
 
 class TrackAcquisition {
@@ -58,6 +62,10 @@ class TrackAcquisition {
   std::expected<void, std::string> after_tracking(const cv::Mat& frame, const vision::WindowImage& image, double t_s,
                                                   const Eigen::Isometry3d& predicted, vision::ModelTracker& tracker,
                                                   TrackPredictor& predictor, vision::FrameReport& report);
+  // After the predictor judged this frame's pose (TrackPredictor::observe, verdict): when a switch
+  // on probation is undone, the predictor as it was before the switch, for the caller to measure
+  // the frame again from; null otherwise. The stretch's rechecks then stop.
+  std::unique_ptr<TrackPredictor> after_verdict(double t_s, std::optional<fusion::VisionVerdict> verdict);
   // A recheck (the schedule said so): the whole search on this frame, and the pose to switch to
   // when it explains a much longer outline than `tracked` (this frame's tracking).
   // Of the poses that draw the same outline, the one turned as `orient_like` is taken.
@@ -87,6 +95,8 @@ class TrackAcquisition {
   bool in_loss_ = false;
   RecheckSchedule rechecks_due_;
   RecheckSwitch switch_;
+  SwitchProbation probation_;
+  std::unique_ptr<TrackPredictor> before_switch_;  // while a switch is on probation
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
   std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a doubtful frame started
   // The last time the tracked pose may have changed what it holds: a detection (start,
@@ -95,7 +105,7 @@ class TrackAcquisition {
   double last_doubt_t_s_ = -INFINITY;
   Eigen::Vector3d centre_obj_;  // vision::model_centre: levelled poses turn about it
   int levelled_ = 0;                                     // found poses levelled to gravity (geometry/level_to_up.h)
-  int rechecks_ = 0, switches_ = 0;
+  int rechecks_ = 0, switches_ = 0, switches_undone_ = 0;
   double last_score_ = 0;
   nlohmann::json recheck_log_ = nlohmann::json::array();  // of the last detection's best hypothesis
   std::vector<int> frames_to_reacquire_;

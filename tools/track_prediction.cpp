@@ -38,6 +38,7 @@ class ConstantVelocityPredictor final : public TrackPredictor {
     motion_.observe(t_s, report.status, report.cam_T_obj);
   }
   std::optional<Eigen::Isometry3d> fused(double) override { return std::nullopt; }
+  std::unique_ptr<TrackPredictor> clone() const override { return std::make_unique<ConstantVelocityPredictor>(*this); }
   nlohmann::json diagnostics() const override { return {{"model", "constant_velocity"}, {"lost_frames", lost_}}; }
 
  private:
@@ -127,6 +128,7 @@ class ImuPredictor final : public TrackPredictor {
   void observe(double t_s, const vision::FrameReport& report) override {
     vision_only_.observe(t_s, report.status, report.cam_T_obj);
     verdict_ = nullptr;
+    first_verdict_.reset();
     if (report.status == vision::TrackStatus::Lost) {
       ++lost_;
       if (t_s - last_good_t_s_ > kLostResetS && !reset_done_) {
@@ -174,6 +176,7 @@ class ImuPredictor final : public TrackPredictor {
     const fusion::PoseSupport support{vision::strongly_supported(report), report.used_fallback};
     const fusion::ArbitratedVision a = arbiter_.add_vision(predictor_, t_s, report.cam_T_obj, report.covariance, support);
     const fusion::VisionVerdict first = a.result.verdict;
+    first_verdict_ = first;
     const bool measured = first == fusion::VisionVerdict::Applied || first == fusion::VisionVerdict::Gated;
     if (measured) nis_.add(a.result.mahalanobis2, a.result.dims);
     const char* restart = fusion::to_string(a.restart);
@@ -212,6 +215,8 @@ class ImuPredictor final : public TrackPredictor {
     return Upright{-*down_cam, -*down_obj, options_.gravity_check.max_tilt_error_rad};
   }
   nlohmann::json frame_verdict() const override { return verdict_; }
+  std::optional<fusion::VisionVerdict> verdict() const override { return first_verdict_; }
+  std::unique_ptr<TrackPredictor> clone() const override { return std::make_unique<ImuPredictor>(*this); }
   nlohmann::json diagnostics() const override {
     const auto st = predictor_.status(last_good_t_s_);
     const auto& c = st.counters;
@@ -327,6 +332,7 @@ class ImuPredictor final : public TrackPredictor {
   int weak_reacquisitions_ = 0, detection_restarts_ = 0;
   fusion::VisionArbiter arbiter_;  // who is wrong when vision and the filter disagree
   nlohmann::json verdict_;  // frame_verdict()
+  std::optional<fusion::VisionVerdict> first_verdict_;  // verdict()
   vision::ConstantVelocity vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
   // Offset estimation (auto).

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "epichead/fusion/predictor.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/sequence.h"
 
@@ -75,6 +76,13 @@ class TrackPredictor {
   // Detection found the object again at t_s (after a loss): predictions restart from this pose
   // at rest, as from init.csv.
   virtual void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) = 0;
+  // After observe(t_s): the filter's verdict on that frame's pose against the filter as it was
+  // (before any restart the pose caused), or nothing when there is no filter or it was not given
+  // the pose. A recheck's switch is on probation on it (tools/switch_probation.h).
+  virtual std::optional<fusion::VisionVerdict> verdict() const { return std::nullopt; }
+  // A copy in its present state: the filter from before a recheck's switch, kept while the switch
+  // is on probation.
+  virtual std::unique_ptr<TrackPredictor> clone() const = 0;
   // After observe(t_s): what the filter did with that frame's pose, for report.json's per_frame
   // ({"verdict", "nis", "restart"}); null when there is no filter or it was not given the pose.
   virtual nlohmann::json frame_verdict() const { return nullptr; }

@@ -96,3 +96,16 @@ TEST_CASE("recheck schedule: off after doubtful frames, or with no provisional t
   b.found_at(0.0);
   CHECK(due_frames(b, TrackStatus::Degraded, 0.0, 90).empty());
 }
+
+TEST_CASE("recheck schedule: quiet ends the stretch's rechecks, and doubt within it starts none, until it is over") {
+  RecheckSchedule s;
+  s.found_at(1.0);
+  CHECK(due_frames(s, TrackStatus::Tracked, 1.0, 4) == std::vector<int>{3});
+  s.quiet();
+  CHECK(due_frames(s, TrackStatus::Tracked, 1.2, 60).empty());
+  CHECK_FALSE(s.due_after(TrackStatus::Degraded, 3.5));  // inside the stretch (until 4.0 s)
+  CHECK(s.started_after_doubt() == 0);
+  CHECK(s.due_after(TrackStatus::Degraded, 4.1));  // after it: a new stretch, rechecked at once
+  s.found_at(5.0);  // a detection starts its own schedule
+  CHECK(due_frames(s, TrackStatus::Tracked, 5.0, 4) == std::vector<int>{3});
+}
