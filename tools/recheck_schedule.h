@@ -59,6 +59,8 @@ class RecheckSchedule {
     next_s_ = t_s + options_.recheck_interval_s;
     return true;
   }
+  // Whether t_s lies within a stretch (after a detection, or a doubtful frame that started one).
+  bool provisional(double t_s) const { return t_s <= provisional_until_s_; }
   // No more rechecks in the stretch under way (a doubtful frame inside it starts none either).
   void quiet() { next_s_ = INFINITY; }
   int started_after_doubt() const { return after_doubt_; }

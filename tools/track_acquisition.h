@@ -98,7 +98,8 @@ class TrackAcquisition {
   SwitchProbation probation_;
   std::unique_ptr<TrackPredictor> before_switch_;  // while a switch is on probation
   std::optional<Eigen::Isometry3d> last_tracked_;  // the last frame's pose with status Tracked
-  std::optional<Eigen::Isometry3d> orient_ref_;    // for the rechecks of a stretch a doubtful frame started
+  // For the rechecks of a stretch a doubtful frame or a re-acquisition started.
+  std::optional<Eigen::Isometry3d> orient_ref_;
   // The last time the tracked pose may have changed what it holds: a detection (start,
   // re-acquisition, switch), or a frame lost, degraded or re-locked. A wrong lock a recheck
   // replaces was held since then at the earliest.
