@@ -452,7 +452,7 @@ int run_track(const TrackArgs& args) {
     (*predictor)->observe(entry.t_s, report);
     bool switch_undone = false;
     if (auto before = acquisition.after_verdict(entry.t_s, (*predictor)->verdict())) {
-      // The filter gated every pose after a recheck's switch: the frame is measured again from the
+      // The filter gated most poses after a recheck's switch: the frame is measured again from the
       // filter as it was before the switch, propagated to now (tools/switch_probation.h). The
       // image's motion (without the IMU) does not run here: the filter that judges is the IMU's.
       *predictor = std::move(before);

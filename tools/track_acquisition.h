@@ -36,8 +36,8 @@ struct AcquisitionOptions {
   // view (late_entry).
   RecheckOptions recheck;
   SwitchOptions switching;
-  // With the IMU, a switch stands once the filter started from it applies a pose, and is undone
-  // when it gates the first few (switch_probation.h).
+  // With the IMU, a switch is undone when the filter started from it gates most of the first
+  // poses after it (switch_probation.h). Without the IMU nothing judges it, and it stands.
   ProbationOptions probation;
 };
 
