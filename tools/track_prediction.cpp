@@ -182,7 +182,8 @@ class ImuPredictor final : public TrackPredictor {
     const char* restart = fusion::to_string(a.restart);
     verdict_ = {{"verdict", fusion::to_string(first)},
                 {"nis", measured ? nlohmann::json(a.result.mahalanobis2) : nlohmann::json(nullptr)},
-                {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)}};
+                {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)},
+                {"strongly_supported", support.strong}};
     if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
     const fusion::VisionResult& r = a.final();
     if (fusion::supersedes_start_pose(r.verdict)) pending_init_ = false;
@@ -254,6 +255,7 @@ class ImuPredictor final : public TrackPredictor {
             {"weak_poses_after_loss", weak_reacquisitions_},
             {"restarts_after_supported_gated", arbiter_.counters().supported_gated},
             {"restarts_after_agreeing_gated", arbiter_.counters().agreeing_gated},
+            {"restarts_velocity_remeasured", arbiter_.counters().velocity_remeasured},
             {"restarts_from_detection", detection_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},

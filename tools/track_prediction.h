@@ -84,7 +84,8 @@ class TrackPredictor {
   // is on probation.
   virtual std::unique_ptr<TrackPredictor> clone() const = 0;
   // After observe(t_s): what the filter did with that frame's pose, for report.json's per_frame
-  // ({"verdict", "nis", "restart"}); null when there is no filter or it was not given the pose.
+  // ({"verdict", "nis", "restart", "strongly_supported"}); null when there is no filter or it was
+  // not given the pose.
   virtual nlohmann::json frame_verdict() const { return nullptr; }
   // Counters for report.json.
   virtual nlohmann::json diagnostics() const = 0;

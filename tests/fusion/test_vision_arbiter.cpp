@@ -134,3 +134,55 @@ TEST_CASE("vision arbiter: gated poses that agree restart the filter with applie
     }
   }
 }
+
+TEST_CASE("vision arbiter: a restart soon after another takes the velocity measured between their poses, not the carried one") {
+  Running r(no_reinit());
+  VisionArbiter arbiter(r.predictor.options().gate_chi2);
+  // The filter starts again with a velocity 1 m/s off (what a drifted filter would carry over).
+  const double t0 = frame_t(0);
+  r.feed_until(t0 + 0.001);
+  NavState wrong = *r.predictor.state();
+  wrong.obj_v_cam += Eigen::Vector3d(1.0, 0, 0);
+  r.predictor.carry_motion(wrong, r.predictor.covariance());
+  r.predictor.reset();
+  REQUIRE(r.predictor.add_vision(t0, r.traj.at(t0).x.cam_T_obj(), pose_cov(0.003, 0.004)).verdict == VisionVerdict::Initialised);
+  // The second opinion finds the object where it is: the first restart carries the velocity over.
+  constexpr PoseSupport kFallback{.strong = true, .from_fallback = true};
+  const double t1 = frame_t(1);
+  r.feed_until(t1 + 0.001);
+  REQUIRE(arbiter.add_vision(r.predictor, t1, r.traj.at(t1).x.cam_T_obj(), pose_cov(0.003, 0.004), kFallback).restart ==
+          RestartReason::Fallback);
+  CHECK(arbiter.counters().velocity_remeasured == 0);
+  CHECK((r.predictor.state()->obj_v_cam - r.traj.at(t1).x.obj_v_cam).norm() > 0.5);
+  // 0.1 s later it has to again: the velocity it carried could not hold. This one measures it.
+  const double t4 = frame_t(4);
+  r.feed_until(t4 + 0.001);
+  REQUIRE(arbiter.add_vision(r.predictor, t4, r.traj.at(t4).x.cam_T_obj(), pose_cov(0.003, 0.004), kFallback).restart ==
+          RestartReason::Fallback);
+  CHECK(arbiter.counters().velocity_remeasured == 1);
+  CHECK((r.predictor.state()->obj_v_cam - r.traj.at(t4).x.obj_v_cam).norm() < 0.2);
+  // Another 0.1 s on, the prediction is within a centimetre (the carried velocity: 10 cm off).
+  const double t7 = t4 + 0.1;
+  r.feed_until(t7 + 0.001);
+  CHECK(translation_error_m(r.predictor, t7, r.traj.at(t7).x.cam_T_obj()) < 0.01);
+}
+
+TEST_CASE("velocity_between: the camera's move in the object frame over the time between, its variance over that time squared") {
+  // The camera 0.1 m further along the object's x after 0.5 s, turned, with 2 mm position sigma.
+  Eigen::Isometry3d obj_T_cam0 = Eigen::Isometry3d::Identity();
+  obj_T_cam0.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  obj_T_cam0.translation() = Eigen::Vector3d(0.05, -0.02, -0.6);
+  Eigen::Isometry3d obj_T_cam1 = obj_T_cam0;
+  obj_T_cam1.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() * obj_T_cam0.linear();
+  obj_T_cam1.translation() += Eigen::Vector3d(0.1, 0, 0);
+  const Matrix6d cov = pose_cov(0.002, 1e-9);
+  const auto v = velocity_between(1.0, obj_T_cam0.inverse(), cov, 1.5, obj_T_cam1.inverse(), cov);
+  REQUIRE(v);
+  CHECK((v->obj_v_cam_mps - Eigen::Vector3d(0.2, 0, 0)).norm() < 1e-9);
+  // Two positions of 2 mm each over 0.5 s: 2 * 4e-6 / 0.25 per axis.
+  CHECK(v->covariance.trace() == Approx(3 * 2 * 4e-6 / 0.25).epsilon(1e-3));
+  CHECK_FALSE(velocity_between(1.5, obj_T_cam0.inverse(), cov, 1.5, obj_T_cam1.inverse(), cov));
+  Eigen::Isometry3d nan = obj_T_cam1.inverse();
+  nan.translation().x() = std::nan("");
+  CHECK_FALSE(velocity_between(1.0, obj_T_cam0.inverse(), cov, 1.5, nan, cov));
+}
