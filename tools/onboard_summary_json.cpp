@@ -81,7 +81,6 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                          {"restarts_from_fallback", s.predictor_restarts.fallback},
                          {"restarts_after_supported_gated", s.predictor_restarts.supported_gated},
                          {"restarts_after_agreeing_gated", s.predictor_restarts.agreeing_gated},
-                         {"restarts_velocity_remeasured", s.predictor_restarts.velocity_remeasured},
                          {"vision_against_gravity", s.predictor.vision_against_gravity},
                          {"vision_unchecked", s.predictor.vision_unchecked},
                          {"unaided_down_updates", s.predictor.unaided_down_updates},

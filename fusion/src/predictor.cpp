@@ -431,25 +431,7 @@ void Predictor::reset() {
   status_.gated_in_a_row = 0;
 }
 
-std::optional<MeasuredVelocity> velocity_between(double t0_s, const Eigen::Isometry3d& cam_T_obj0, const Matrix6d& cov0,
-                                                 double t1_s, const Eigen::Isometry3d& cam_T_obj1, const Matrix6d& cov1) {
-  const double dt = t1_s - t0_s;
-  if (!(dt > 0) || !cam_T_obj0.matrix().allFinite() || !cam_T_obj1.matrix().allFinite() || !cov0.allFinite() || !cov1.allFinite())
-    return std::nullopt;
-  const Eigen::Isometry3d obj_T_cam0 = cam_T_obj0.inverse(), obj_T_cam1 = cam_T_obj1.inverse();
-  // Each position's covariance in the object frame, as the filter's own error (dtheta, dp) holds it.
-  const auto position_cov = [](const Eigen::Isometry3d& obj_T_cam, const Matrix6d& cov) -> Eigen::Matrix3d {
-    const Matrix6d J = geometry::filter_pose_error_jacobian(obj_T_cam.linear());
-    return (J * cov * J.transpose()).block<3, 3>(3, 3);
-  };
-  MeasuredVelocity v;
-  v.obj_v_cam_mps = (obj_T_cam1.translation() - obj_T_cam0.translation()) / dt;
-  v.covariance = (position_cov(obj_T_cam0, cov0) + position_cov(obj_T_cam1, cov1)) / (dt * dt);
-  return v;
-}
-
-VisionResult Predictor::restart_keeping_motion(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                               const std::optional<MeasuredVelocity>& velocity) {
+VisionResult Predictor::restart_keeping_motion(double t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov) {
   const std::optional<PosePrediction> before = predict(t_s);
   const StateEntry* e = imu_.newest_state();
   if (before && e && cam_T_obj.matrix().allFinite()) {
@@ -463,13 +445,6 @@ VisionResult Predictor::restart_keeping_motion(double t_s, const Eigen::Isometry
     ErrorCovariance P = e->P;
     P.middleRows<3>(err::v) = turn * P.middleRows<3>(err::v);
     P.middleCols<3>(err::v) = P.middleCols<3>(err::v) * turn.transpose();
-    if (velocity) {
-      // Measured, not carried: nothing it is correlated with in the filter's state.
-      motion.obj_v_cam = velocity->obj_v_cam_mps;
-      P.middleRows<3>(err::v).setZero();
-      P.middleCols<3>(err::v).setZero();
-      P.block<3, 3>(err::v, err::v) = 0.5 * (velocity->covariance + velocity->covariance.transpose());
-    }
     imu_.carry_motion(motion, P);
   }
   reset();

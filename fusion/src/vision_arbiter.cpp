@@ -38,15 +38,7 @@ ArbitratedVision VisionArbiter::add_vision(Predictor& filter, double exposure_t_
   } else {
     return out;
   }
-  std::optional<MeasuredVelocity> velocity;
-  if (exposure_t_s - last_restart_.t_s < kRemeasureVelocityWithinS)
-    velocity = velocity_between(last_restart_.t_s, last_restart_.cam_T_obj, last_restart_.cov, exposure_t_s, cam_T_obj, cov);
-  if (velocity) {
-    velocity->covariance.diagonal().array() += kVelocityFloorMps * kVelocityFloorMps;
-    ++counters_.velocity_remeasured;
-  }
-  out.after_restart = filter.restart_keeping_motion(exposure_t_s, cam_T_obj, cov, velocity);
-  last_restart_ = {exposure_t_s, cam_T_obj, cov};
+  out.after_restart = filter.restart_keeping_motion(exposure_t_s, cam_T_obj, cov);
   clear();
   return out;
 }

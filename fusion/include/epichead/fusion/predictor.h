@@ -71,19 +71,6 @@ struct VisionResult {
   int dims = 6;             // its degrees of freedom: 5 for a pose with a free direction (free_direction.h)
 };
 
-// The camera's velocity in the object frame measured from two vision poses, with its covariance.
-struct MeasuredVelocity {
-  Eigen::Vector3d obj_v_cam_mps = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-};
-
-// The camera's mean velocity between two vision poses exposed at t0_s < t1_s (their 6x6
-// covariances in the vision poses' order): the move of its position in the object frame over the
-// time between, its variance the two positions' over that time squared. Nothing when t1_s <= t0_s
-// or a pose is not finite.
-std::optional<MeasuredVelocity> velocity_between(double t0_s, const Eigen::Isometry3d& cam_T_obj0, const Matrix6d& cov0,
-                                                 double t1_s, const Eigen::Isometry3d& cam_T_obj1, const Matrix6d& cov1);
-
 struct PredictorCounters {
   std::uint64_t imu_accepted = 0, imu_buffered = 0, imu_non_finite = 0, imu_saturated = 0, imu_out_of_order = 0,
                 imu_duplicate = 0, imu_time_jump = 0, imu_ignored = 0;
@@ -156,10 +143,7 @@ class Predictor {
   // A restart from defaults starts the velocity at zero and gravity from the accelerometer's mean:
   // in a hand-held motion the translation then ran off 10-15 mm a frame (development lampshade 5,
   // tools/track_prediction.cpp's restarts; docs/fusion.md, "Gated poses that agree").
-  // `velocity`, when given, replaces the carried velocity (and its variance): the camera's motion
-  // measured between two vision poses (fusion/vision_arbiter.h, a restart soon after another).
-  VisionResult restart_keeping_motion(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov,
-                                      const std::optional<MeasuredVelocity>& velocity = std::nullopt);
+  VisionResult restart_keeping_motion(double exposure_t_s, const Eigen::Isometry3d& cam_T_obj, const Matrix6d& cov);
   // The next initialisation takes velocity, biases and gravity direction (and their variances)
   // from `motion` instead of the defaults: for a restart on a corrected clock (the camera-IMU
   // time offset just estimated) while the motion state learnt so far still holds. A restart from

@@ -15,14 +15,6 @@
 // Poses the image supports weakly never overrule the filter here; the filter's own
 // reinit_after_gated does, once it is surely lost too (`track` sets it to half a second of frames).
 //
-// A restart within kRemeasureVelocityWithinS of the one before does not carry the velocity over:
-// the velocity carried last time could not hold the object for even that long. It takes instead
-// the camera's motion between the two restarts' poses, both of which overruled the filter
-// (fusion::velocity_between). Held-out lampshade 255 with the IMU: after a start 6 deg off, the
-// carried velocity drove the translation off 7-20 mm a frame, and the fallback restarted the
-// filter every fourth frame for 100 frames. A restart at rest instead runs off in a hand-held
-// motion (development lampshade 6).
-//
 // One arbiter per filter, given every vision pose the filter is given; `epichead track` and the
 // onboard loop use it alike. It holds no reference to the filter, which the caller may replace
 // (track's restart on an estimated clock offset): each call names it.
@@ -55,7 +47,6 @@ struct ArbitratedVision {
 
 struct ArbiterCounters {
   std::uint64_t fallback = 0, supported_gated = 0, agreeing_gated = 0;  // restarts, by reason
-  std::uint64_t velocity_remeasured = 0;  // of them, with the velocity measured between two restarts
 };
 
 class VisionArbiter {
@@ -73,20 +64,8 @@ class VisionArbiter {
 
  private:
   static constexpr int kSupportedGatedRestart = 3;
-  static constexpr double kRemeasureVelocityWithinS = 0.5;  // 15 frames at 30 fps
-  // Added (in quadrature) to the measured velocity's 1-sigma: the mean over the span is not the
-  // velocity at its end, and a pose's position is often off by more than its covariance says
-  // (development late_entry 4: a restart 17 mm off, 0.2 s before the next, drove the translation
-  // off 6 mm a frame with the two covariances alone).
-  static constexpr double kVelocityFloorMps = 0.15;
   GatedAgreement agreement_;
   int supported_gated_ = 0;  // strongly supported gated poses in a row
-  // The last restart's pose (clear() keeps it: a reset from elsewhere does not undo a restart).
-  struct Restart {
-    double t_s = -1e300;
-    Eigen::Isometry3d cam_T_obj = Eigen::Isometry3d::Identity();
-    Matrix6d cov = Matrix6d::Identity();
-  } last_restart_;
   ArbiterCounters counters_;
 };
 
