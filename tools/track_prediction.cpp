@@ -148,7 +148,7 @@ class ImuPredictor final : public TrackPredictor {
       // started on it holds the windows there (can, after its 1 s cover: 14 deg off for good).
       // Meanwhile the windows follow the vision poses (predict() falls back to last_good_).
       ++weak_reacquisitions_;
-      verdict_ = {{"verdict", "held-weak-after-loss"}, {"nis", nullptr}, {"restart", nullptr}};
+      verdict_ = {{"verdict", "held-weak-after-loss"}, {"nis", nullptr}, {"restart", nullptr}, {"strongly_supported", false}};
       return;
     }
     reset_done_ = false;
@@ -159,7 +159,8 @@ class ImuPredictor final : public TrackPredictor {
         frames_since_fit_ = 0;
         if (const auto e = estimator_->estimate()) {
           const fusion::VisionResult adopted = adopt(*e, t_s, report);
-          verdict_ = {{"verdict", fusion::to_string(adopted.verdict)}, {"nis", nullptr}, {"restart", "clock-offset-estimated"}};
+          verdict_ = {{"verdict", fusion::to_string(adopted.verdict)}, {"nis", nullptr}, {"restart", "clock-offset-estimated"},
+                      {"strongly_supported", vision::strongly_supported(report)}};
           return;
         }
       }
@@ -255,7 +256,6 @@ class ImuPredictor final : public TrackPredictor {
             {"weak_poses_after_loss", weak_reacquisitions_},
             {"restarts_after_supported_gated", arbiter_.counters().supported_gated},
             {"restarts_after_agreeing_gated", arbiter_.counters().agreeing_gated},
-            {"restarts_velocity_remeasured", arbiter_.counters().velocity_remeasured},
             {"restarts_from_detection", detection_restarts_},
             {"vision_nis", nis_.to_json()},
             {"fallbacks_to_last_pose", fallbacks_},

@@ -190,7 +190,7 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   std::nth_element(tilts.begin(), tilts.begin() + tilts.size() / 2, tilts.end());
   CHECK(tilts[tilts.size() / 2] < 1.0);
   // Each frame the filter was given says what it did; the counts agree with the predictor's.
-  int applied = 0, gated = 0, restarts = 0, given = 0;
+  int applied = 0, gated = 0, restarts = 0, given = 0, strong = 0;
   for (const auto& f : report["per_frame"]) {
     if (!f.contains("filter")) {
       CHECK(f["status"] == "lost");
@@ -202,7 +202,10 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
     gated += v["verdict"] == "gated";
     restarts += !v["restart"].is_null();
     if (v["verdict"] == "applied" || v["verdict"] == "gated") CHECK(v["nis"].get<double>() >= 0);
+    // What the arbiter read of the pose's support; a clean run's poses are nearly all strong.
+    strong += v["strongly_supported"].get<bool>();
   }
+  CHECK(strong > 50);
   const auto& p = report["predictor"];
   CHECK(given == 75 - report["lost"].get<int>());
   CHECK(applied == p["vision_applied"].get<int>());
