@@ -16,6 +16,16 @@
 namespace epichead::tools {
 namespace {
 
+// One frame's report.json per_frame "filter" entry (TrackPredictor::frame_verdict): the same keys
+// whichever way the pose went. nis null when the filter did not measure the pose; restart null when
+// it did not restart from it.
+nlohmann::json filter_verdict_json(const char* verdict, std::optional<double> nis, const char* restart, bool strongly_supported) {
+  return {{"verdict", verdict},
+          {"nis", nis ? nlohmann::json(*nis) : nlohmann::json(nullptr)},
+          {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)},
+          {"strongly_supported", strongly_supported}};
+}
+
 // 1-sigma of the camera-IMU time offset while it is unknown (--imu-time-offset-s auto, before the
 // estimate is adopted): a recorded imu.csv on its own device clock, as USB or CAN IMUs stamp and
 // the simulator writes, is typically some 5-25 ms off the camera's. Measured on the jerk sweep's
@@ -148,7 +158,7 @@ class ImuPredictor final : public TrackPredictor {
       // started on it holds the windows there (can, after its 1 s cover: 14 deg off for good).
       // Meanwhile the windows follow the vision poses (predict() falls back to last_good_).
       ++weak_reacquisitions_;
-      verdict_ = {{"verdict", "held-weak-after-loss"}, {"nis", nullptr}, {"restart", nullptr}, {"strongly_supported", false}};
+      verdict_ = filter_verdict_json("held-weak-after-loss", std::nullopt, nullptr, false);
       return;
     }
     reset_done_ = false;
@@ -159,8 +169,8 @@ class ImuPredictor final : public TrackPredictor {
         frames_since_fit_ = 0;
         if (const auto e = estimator_->estimate()) {
           const fusion::VisionResult adopted = adopt(*e, t_s, report);
-          verdict_ = {{"verdict", fusion::to_string(adopted.verdict)}, {"nis", nullptr}, {"restart", "clock-offset-estimated"},
-                      {"strongly_supported", vision::strongly_supported(report)}};
+          verdict_ = filter_verdict_json(fusion::to_string(adopted.verdict), std::nullopt, "clock-offset-estimated",
+                                         vision::strongly_supported(report));
           return;
         }
       }
@@ -181,10 +191,8 @@ class ImuPredictor final : public TrackPredictor {
     const bool measured = first == fusion::VisionVerdict::Applied || first == fusion::VisionVerdict::Gated;
     if (measured) nis_.add(a.result.mahalanobis2, a.result.dims);
     const char* restart = fusion::to_string(a.restart);
-    verdict_ = {{"verdict", fusion::to_string(first)},
-                {"nis", measured ? nlohmann::json(a.result.mahalanobis2) : nlohmann::json(nullptr)},
-                {"restart", restart ? nlohmann::json(restart) : nlohmann::json(nullptr)},
-                {"strongly_supported", support.strong}};
+    verdict_ = filter_verdict_json(fusion::to_string(first), measured ? std::optional(a.result.mahalanobis2) : std::nullopt, restart,
+                                   support.strong);
     if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
     const fusion::VisionResult& r = a.final();
     if (fusion::supersedes_start_pose(r.verdict)) pending_init_ = false;
