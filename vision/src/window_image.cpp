@@ -13,6 +13,8 @@ namespace {
 
 // Side of the square tiles the frame is converted by, px.
 constexpr int kTilePx = 32;
+// Floats per plane of a tile's scratch: the tile and its two-pixel margins.
+constexpr std::size_t kScratchPlane = (kTilePx + 4) * (kTilePx + 4);
 
 // Intensity and chromaticities of one pixel (b, g, r as floats) into i, cr, cg.
 inline void colour_of(float b, float g, float r, float& i, float& cr, float& cg) {
@@ -66,12 +68,7 @@ std::expected<void, std::string> WindowImage::assign(const cv::Mat& frame) {
   const int w = frame.cols, h = frame.rows;
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   if (pixels_.size() < 4 * n) pixels_.resize(4 * n);
-  if (intensity_.size() < n) {
-    intensity_.resize(n);
-    chroma_r_.resize(n);
-    chroma_g_.resize(n);
-    gradient_.resize(n);
-  }
+  if (scratch_.empty()) scratch_.resize(4 * kScratchPlane);
   width_px_ = w;
   height_px_ = h;
   colour_ = frame.channels() >= 3;
@@ -119,25 +116,35 @@ void WindowImage::prepare_span(float xa, float ya, float xb, float yb) const {
 // A tile's four channels. The texture's 3x3 mean needs the gradient one pixel around the tile,
 // which needs the intensity two pixels around it: those margins are computed again for each
 // tile that needs them (the same values each time), which costs less than tracking which of
-// them a neighbouring tile already made.
+// them a neighbouring tile already made. The intensity, chromaticities and gradient live only in
+// a scratch the size of a tile and its margins, which stays in the L1 cache; only the
+// interleaved result is written to the frame-sized buffer.
 void WindowImage::prepare_tile(int tx, int ty) const {
   const int w = width_px_, h = height_px_;
   const int x0 = tx * kTilePx, x1 = std::min(w, x0 + kTilePx);
   const int y0 = ty * kTilePx, y1 = std::min(h, y0 + kTilePx);
-  for (int y = std::max(y0 - 2, 0); y < std::min(y1 + 2, h); ++y) colour_row(y, std::max(x0 - 2, 0), std::min(x1 + 2, w));
-  for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, h); ++y) gradient_row(y, std::max(x0 - 1, 0), std::min(x1 + 1, w));
-  for (int y = y0; y < y1; ++y) interleave_row(y, x0, x1);
+  TileScratch t;
+  t.x0 = std::max(x0 - 2, 0);
+  t.y0 = std::max(y0 - 2, 0);
+  t.stride = std::min(x1 + 2, w) - t.x0;
+  t.intensity = scratch_.data();
+  t.chroma_r = t.intensity + kScratchPlane;
+  t.chroma_g = t.chroma_r + kScratchPlane;
+  t.gradient = t.chroma_g + kScratchPlane;
+  for (int y = t.y0; y < std::min(y1 + 2, h); ++y) colour_row(t, y, t.x0, std::min(x1 + 2, w));
+  for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, h); ++y) gradient_row(t, y, std::max(x0 - 1, 0), std::min(x1 + 1, w));
+  for (int y = y0; y < y1; ++y) interleave_row(t, y, x0, x1);
   tile_ready_[static_cast<std::size_t>(ty) * tiles_x_ + tx] = 1;
   ++tiles_prepared_;
 }
 
-// Intensity and chromaticity of row y, columns [x0, x1).
-void WindowImage::colour_row(int y, int x0, int x1) const {
-  const std::size_t at = static_cast<std::size_t>(y) * width_px_ + x0;
-  const std::uint8_t* src = bytes_.data() + at * channels_;
-  float* I = intensity_.data() + at;
-  float* R = chroma_r_.data() + at;
-  float* G = chroma_g_.data() + at;
+// Intensity and chromaticity of row y, columns [x0, x1), into the scratch.
+void WindowImage::colour_row(const TileScratch& t, int y, int x0, int x1) const {
+  const std::uint8_t* src = bytes_.data() + (static_cast<std::size_t>(y) * width_px_ + x0) * channels_;
+  const std::size_t at = t.at(y, x0);
+  float* I = t.intensity + at;
+  float* R = t.chroma_r + at;
+  float* G = t.chroma_g + at;
   const int n = x1 - x0;
   switch (channels_) {
     case 3: colour_run_bgr(src, I, R, G, n); return;
@@ -150,49 +157,49 @@ void WindowImage::colour_row(int y, int x0, int x1) const {
 }
 
 // |dI/dx| + |dI/dy| (halved) by central differences of row y, columns [x0, x1), the border
-// replicated. The interior run has no clamps, so it vectorises; the per-pixel arithmetic is the
-// same at the border and inside.
-void WindowImage::gradient_row(int y, int x0, int x1) const {
+// replicated, into the scratch. The interior run has no clamps, so it vectorises; the per-pixel
+// arithmetic is the same at the border and inside. Scratch columns are counted from t.x0.
+void WindowImage::gradient_row(const TileScratch& t, int y, int x0, int x1) const {
   const int w = width_px_, h = height_px_;
-  const float* I = intensity_.data();
-  const float* __restrict up = I + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
-  const float* __restrict row = I + static_cast<std::size_t>(y) * w;
-  const float* __restrict down = I + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
-  float* __restrict out = gradient_.data() + static_cast<std::size_t>(y) * w;
+  const float* __restrict up = t.intensity + t.at(std::max(y - 1, 0), t.x0);
+  const float* __restrict row = t.intensity + t.at(y, t.x0);
+  const float* __restrict down = t.intensity + t.at(std::min(y + 1, h - 1), t.x0);
+  float* __restrict out = t.gradient + t.at(y, t.x0);
   auto border = [&](int x) {
-    const int xm = std::max(x - 1, 0), xp = std::min(x + 1, w - 1);
-    out[x] = 0.5f * (std::fabs(row[xp] - row[xm]) + std::fabs(down[x] - up[x]));
+    const int xm = std::max(x - 1, 0) - t.x0, xp = std::min(x + 1, w - 1) - t.x0, c = x - t.x0;
+    out[c] = 0.5f * (std::fabs(row[xp] - row[xm]) + std::fabs(down[c] - up[c]));
   };
   if (x0 == 0) border(0);
-  gradient_run(up, row, down, out, std::max(x0, 1), std::min(x1, w - 1));
+  gradient_run(up, row, down, out, std::max(x0, 1) - t.x0, std::min(x1, w - 1) - t.x0);
   if (x1 == w && w > 1) border(w - 1);
 }
 
 // The 3x3 mean of the gradient (the texture) of row y, columns [x0, x1), the border replicated,
 // interleaved with the three planes into pixels_. The nine terms are summed in the same order
 // everywhere, so the interior (vectorised: the four stores form one group) and the border agree.
-void WindowImage::interleave_row(int y, int x0, int x1) const {
+void WindowImage::interleave_row(const TileScratch& t, int y, int x0, int x1) const {
   const int w = width_px_, h = height_px_;
-  const std::size_t row = static_cast<std::size_t>(y) * w;
-  const float* __restrict r0 = gradient_.data() + static_cast<std::size_t>(std::max(y - 1, 0)) * w;
-  const float* __restrict r1 = gradient_.data() + row;
-  const float* __restrict r2 = gradient_.data() + static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
-  const float* __restrict I = intensity_.data() + row;
-  const float* __restrict R = chroma_r_.data() + row;
-  const float* __restrict G = chroma_g_.data() + row;
-  float* __restrict dst = pixels_.data() + 4 * row;
+  const float* __restrict r0 = t.gradient + t.at(std::max(y - 1, 0), t.x0);
+  const float* __restrict r1 = t.gradient + t.at(y, t.x0);
+  const float* __restrict r2 = t.gradient + t.at(std::min(y + 1, h - 1), t.x0);
+  const float* __restrict I = t.intensity + t.at(y, t.x0);
+  const float* __restrict R = t.chroma_r + t.at(y, t.x0);
+  const float* __restrict G = t.chroma_g + t.at(y, t.x0);
+  // dst[4 * c] is pixel t.x0 + c of row y.
+  float* __restrict dst = pixels_.data() + 4 * (static_cast<std::size_t>(y) * w + t.x0);
   auto mean = [&](int xm, int x, int xp) {
     return (r0[xm] + r0[x] + r0[xp] + r1[xm] + r1[x] + r1[xp] + r2[xm] + r2[x] + r2[xp]) * (1.0f / 9.0f);
   };
-  auto put = [&](int x, float texture) {
-    dst[4 * x + 0] = I[x];
-    dst[4 * x + 1] = R[x];
-    dst[4 * x + 2] = G[x];
-    dst[4 * x + 3] = texture;
+  auto put = [&](int c, float texture) {
+    dst[4 * c + 0] = I[c];
+    dst[4 * c + 1] = R[c];
+    dst[4 * c + 2] = G[c];
+    dst[4 * c + 3] = texture;
   };
-  if (x0 == 0) put(0, mean(0, 0, std::min(1, w - 1)));
-  texture_run(r0, r1, r2, I, R, G, dst, std::max(x0, 1), std::min(x1, w - 1));
-  if (x1 == w && w > 1) put(w - 1, mean(w - 2, w - 1, w - 1));
+  const int o = t.x0;
+  if (x0 == 0) put(0 - o, mean(0 - o, 0 - o, std::min(1, w - 1) - o));
+  texture_run(r0, r1, r2, I, R, G, dst, std::max(x0, 1) - o, std::min(x1, w - 1) - o);
+  if (x1 == w && w > 1) put(w - 1 - o, mean(w - 2 - o, w - 1 - o, w - 1 - o));
 }
 
 }  // namespace epichead::vision
