@@ -131,6 +131,16 @@ void WindowImage::prepare_tile(int tx, int ty) const {
   t.chroma_r = t.intensity + kScratchPlane;
   t.chroma_g = t.chroma_r + kScratchPlane;
   t.gradient = t.chroma_g + kScratchPlane;
+  // The tile's bytes and output rows are requested before they are needed: rows lie a frame's
+  // width apart, a stride the hardware prefetchers do not follow over a tile's few lines.
+  for (int y = t.y0; y < std::min(y1 + 2, h); ++y) {
+    const std::uint8_t* src = bytes_.data() + (static_cast<std::size_t>(y) * w + t.x0) * channels_;
+    for (int b = 0; b < t.stride * channels_; b += 64) __builtin_prefetch(src + b, 0, 3);
+  }
+  for (int y = y0; y < y1; ++y) {
+    const float* dst = pixels_.data() + 4 * (static_cast<std::size_t>(y) * w + x0);
+    for (int f = 0; f < 4 * (x1 - x0); f += 16) __builtin_prefetch(dst + f, 1, 3);
+  }
   for (int y = t.y0; y < std::min(y1 + 2, h); ++y) colour_row(t, y, t.x0, std::min(x1 + 2, w));
   for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, h); ++y) gradient_row(t, y, std::max(x0 - 1, 0), std::min(x1 + 1, w));
   for (int y = y0; y < y1; ++y) interleave_row(t, y, x0, x1);
