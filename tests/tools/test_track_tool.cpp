@@ -215,6 +215,39 @@ TEST_CASE("track --imu on writes the filter's estimate, which rides out the pose
   CHECK(applied > 50);
 }
 
+TEST_CASE("track --imu on does not give a filter seeded out of view a chance lock its spread prediction made") {
+  // late_entry seed 276: init.csv's pose with the object out of view until frame 24; the filter,
+  // carried by the IMU alone with its velocity unknown, predicts the object 245 px (1-sigma)
+  // from nowhere in particular, and the tracker re-locks there on part of the object, 7 deg and
+  // 196 mm off. Applied, that lock held the run at 0 % (the twin after it, at 180 deg).
+  TempDir tmp("epichead_test_track_unplaceable");
+  const std::string seq = tmp / "late_entry", out = tmp / "track";
+  REQUIRE(run_epichead(tmp, "sim late_entry --seed 276 --out " + q(seq) + " --frames 60").exit_code == 0);
+  // --no-reacquire: detection would build the package's templates (minutes under the sanitizers).
+  const auto report = track_report(tmp, seq, out, "--imu on --no-reacquire --every 0 --no-video");
+  CHECK(report["predictor"]["weak_poses_unplaceable"].get<int>() > 0);
+  // Until the first pose the image supports well, no pose reaches the filter.
+  bool strong_seen = false;
+  for (const auto& f : report["per_frame"]) {
+    if (!f.contains("filter")) continue;
+    const auto& v = f["filter"];
+    strong_seen = strong_seen || v["strongly_supported"].get<bool>();
+    if (!strong_seen) {
+      INFO("frame " << f["frame"] << " " << v.dump());
+      CHECK(v["verdict"] == "held-weak-unplaceable");
+      CHECK(v["predicted_sigma_px"].get<double>() > 40);
+    }
+  }
+  CHECK(strong_seen);
+  const auto r = run_epichead(tmp, "score " + q(seq) + " " + q(out + "/poses.csv") + " --json");
+  REQUIRE(r.exit_code == 0);
+  const auto score = nlohmann::json::parse(r.out);
+  INFO(score.dump());
+  // Every frame the object is in view (from 24 on) within 5 cm / 5 deg; it was none.
+  CHECK(score["present"].get<int>() >= 30);
+  CHECK(score["succeeded"].get<int>() >= score["present"].get<int>() - 1);
+}
+
 TEST_CASE("track without the IMU follows a hand-held burst by the frame's own motion, which constant velocity misses") {
   TempDir tmp("epichead_test_track_image_motion");
   const std::string seq = tmp / "box_clutter";
