@@ -59,6 +59,84 @@ EPICHEAD_AVX2_CLONE void texture_run(const float* __restrict r0, const float* __
   }
 }
 
+// One tile's conversion: the frame's bytes and pixels, and where the tile's intermediate planes
+// are (row y, column x of the image at at(y, x)).
+struct Tile {
+  const std::uint8_t* bytes = nullptr;
+  int channels = 0, w = 0, h = 0;
+  float* pixels = nullptr;
+  int x0 = 0, y0 = 0, stride = 0;
+  float* intensity = nullptr;
+  float* chroma_r = nullptr;
+  float* chroma_g = nullptr;
+  float* gradient = nullptr;
+  std::size_t at(int y, int x) const { return static_cast<std::size_t>(y - y0) * stride + (x - x0); }
+};
+
+// Intensity and chromaticity of row y, columns [x0, x1), into the scratch.
+void colour_row(const Tile& t, int y, int x0, int x1) {
+  const std::uint8_t* src = t.bytes + (static_cast<std::size_t>(y) * t.w + x0) * t.channels;
+  const std::size_t at = t.at(y, x0);
+  float* I = t.intensity + at;
+  float* R = t.chroma_r + at;
+  float* G = t.chroma_g + at;
+  const int n = x1 - x0;
+  switch (t.channels) {
+    case 3: colour_run_bgr(src, I, R, G, n); return;
+    case 4: colour_run_bgra(src, I, R, G, n); return;
+    default:
+      for (int i = 0; i < n; ++i) I[i] = src[i];
+      std::fill_n(R, n, 85.0f);  // 255 / 3: grey
+      std::fill_n(G, n, 85.0f);
+  }
+}
+
+// |dI/dx| + |dI/dy| (halved) by central differences of row y, columns [x0, x1), the border
+// replicated, into the scratch. The interior run has no clamps, so it vectorises; the per-pixel
+// arithmetic is the same at the border and inside. Scratch columns are counted from t.x0.
+void gradient_row(const Tile& t, int y, int x0, int x1) {
+  const int w = t.w, h = t.h;
+  const float* __restrict up = t.intensity + t.at(std::max(y - 1, 0), t.x0);
+  const float* __restrict row = t.intensity + t.at(y, t.x0);
+  const float* __restrict down = t.intensity + t.at(std::min(y + 1, h - 1), t.x0);
+  float* __restrict out = t.gradient + t.at(y, t.x0);
+  auto border = [&](int x) {
+    const int xm = std::max(x - 1, 0) - t.x0, xp = std::min(x + 1, w - 1) - t.x0, c = x - t.x0;
+    out[c] = 0.5f * (std::fabs(row[xp] - row[xm]) + std::fabs(down[c] - up[c]));
+  };
+  if (x0 == 0) border(0);
+  gradient_run(up, row, down, out, std::max(x0, 1) - t.x0, std::min(x1, w - 1) - t.x0);
+  if (x1 == w && w > 1) border(w - 1);
+}
+
+// The 3x3 mean of the gradient (the texture) of row y, columns [x0, x1), the border replicated,
+// interleaved with the three planes into the frame-sized pixels. The nine terms are summed in the same order
+// everywhere, so the interior (vectorised: the four stores form one group) and the border agree.
+void interleave_row(const Tile& t, int y, int x0, int x1) {
+  const int w = t.w, h = t.h;
+  const float* __restrict r0 = t.gradient + t.at(std::max(y - 1, 0), t.x0);
+  const float* __restrict r1 = t.gradient + t.at(y, t.x0);
+  const float* __restrict r2 = t.gradient + t.at(std::min(y + 1, h - 1), t.x0);
+  const float* __restrict I = t.intensity + t.at(y, t.x0);
+  const float* __restrict R = t.chroma_r + t.at(y, t.x0);
+  const float* __restrict G = t.chroma_g + t.at(y, t.x0);
+  // dst[4 * c] is pixel t.x0 + c of row y.
+  float* __restrict dst = t.pixels + 4 * (static_cast<std::size_t>(y) * w + t.x0);
+  auto mean = [&](int xm, int x, int xp) {
+    return (r0[xm] + r0[x] + r0[xp] + r1[xm] + r1[x] + r1[xp] + r2[xm] + r2[x] + r2[xp]) * (1.0f / 9.0f);
+  };
+  auto put = [&](int c, float texture) {
+    dst[4 * c + 0] = I[c];
+    dst[4 * c + 1] = R[c];
+    dst[4 * c + 2] = G[c];
+    dst[4 * c + 3] = texture;
+  };
+  const int o = t.x0;
+  if (x0 == 0) put(0 - o, mean(0 - o, 0 - o, std::min(1, w - 1) - o));
+  texture_run(r0, r1, r2, I, R, G, dst, std::max(x0, 1) - o, std::min(x1, w - 1) - o);
+  if (x1 == w && w > 1) put(w - 1 - o, mean(w - 2 - o, w - 1 - o, w - 1 - o));
+}
+
 }  // namespace
 
 std::expected<void, std::string> WindowImage::assign(const cv::Mat& frame) {
@@ -123,7 +201,12 @@ void WindowImage::prepare_tile(int tx, int ty) const {
   const int w = width_px_, h = height_px_;
   const int x0 = tx * kTilePx, x1 = std::min(w, x0 + kTilePx);
   const int y0 = ty * kTilePx, y1 = std::min(h, y0 + kTilePx);
-  TileScratch t;
+  Tile t;
+  t.bytes = bytes_.data();
+  t.channels = channels_;
+  t.w = w;
+  t.h = h;
+  t.pixels = pixels_.data();
   t.x0 = std::max(x0 - 2, 0);
   t.y0 = std::max(y0 - 2, 0);
   t.stride = std::min(x1 + 2, w) - t.x0;
@@ -146,70 +229,6 @@ void WindowImage::prepare_tile(int tx, int ty) const {
   for (int y = y0; y < y1; ++y) interleave_row(t, y, x0, x1);
   tile_ready_[static_cast<std::size_t>(ty) * tiles_x_ + tx] = 1;
   ++tiles_prepared_;
-}
-
-// Intensity and chromaticity of row y, columns [x0, x1), into the scratch.
-void WindowImage::colour_row(const TileScratch& t, int y, int x0, int x1) const {
-  const std::uint8_t* src = bytes_.data() + (static_cast<std::size_t>(y) * width_px_ + x0) * channels_;
-  const std::size_t at = t.at(y, x0);
-  float* I = t.intensity + at;
-  float* R = t.chroma_r + at;
-  float* G = t.chroma_g + at;
-  const int n = x1 - x0;
-  switch (channels_) {
-    case 3: colour_run_bgr(src, I, R, G, n); return;
-    case 4: colour_run_bgra(src, I, R, G, n); return;
-    default:
-      for (int i = 0; i < n; ++i) I[i] = src[i];
-      std::fill_n(R, n, 85.0f);  // 255 / 3: grey
-      std::fill_n(G, n, 85.0f);
-  }
-}
-
-// |dI/dx| + |dI/dy| (halved) by central differences of row y, columns [x0, x1), the border
-// replicated, into the scratch. The interior run has no clamps, so it vectorises; the per-pixel
-// arithmetic is the same at the border and inside. Scratch columns are counted from t.x0.
-void WindowImage::gradient_row(const TileScratch& t, int y, int x0, int x1) const {
-  const int w = width_px_, h = height_px_;
-  const float* __restrict up = t.intensity + t.at(std::max(y - 1, 0), t.x0);
-  const float* __restrict row = t.intensity + t.at(y, t.x0);
-  const float* __restrict down = t.intensity + t.at(std::min(y + 1, h - 1), t.x0);
-  float* __restrict out = t.gradient + t.at(y, t.x0);
-  auto border = [&](int x) {
-    const int xm = std::max(x - 1, 0) - t.x0, xp = std::min(x + 1, w - 1) - t.x0, c = x - t.x0;
-    out[c] = 0.5f * (std::fabs(row[xp] - row[xm]) + std::fabs(down[c] - up[c]));
-  };
-  if (x0 == 0) border(0);
-  gradient_run(up, row, down, out, std::max(x0, 1) - t.x0, std::min(x1, w - 1) - t.x0);
-  if (x1 == w && w > 1) border(w - 1);
-}
-
-// The 3x3 mean of the gradient (the texture) of row y, columns [x0, x1), the border replicated,
-// interleaved with the three planes into pixels_. The nine terms are summed in the same order
-// everywhere, so the interior (vectorised: the four stores form one group) and the border agree.
-void WindowImage::interleave_row(const TileScratch& t, int y, int x0, int x1) const {
-  const int w = width_px_, h = height_px_;
-  const float* __restrict r0 = t.gradient + t.at(std::max(y - 1, 0), t.x0);
-  const float* __restrict r1 = t.gradient + t.at(y, t.x0);
-  const float* __restrict r2 = t.gradient + t.at(std::min(y + 1, h - 1), t.x0);
-  const float* __restrict I = t.intensity + t.at(y, t.x0);
-  const float* __restrict R = t.chroma_r + t.at(y, t.x0);
-  const float* __restrict G = t.chroma_g + t.at(y, t.x0);
-  // dst[4 * c] is pixel t.x0 + c of row y.
-  float* __restrict dst = pixels_.data() + 4 * (static_cast<std::size_t>(y) * w + t.x0);
-  auto mean = [&](int xm, int x, int xp) {
-    return (r0[xm] + r0[x] + r0[xp] + r1[xm] + r1[x] + r1[xp] + r2[xm] + r2[x] + r2[xp]) * (1.0f / 9.0f);
-  };
-  auto put = [&](int c, float texture) {
-    dst[4 * c + 0] = I[c];
-    dst[4 * c + 1] = R[c];
-    dst[4 * c + 2] = G[c];
-    dst[4 * c + 3] = texture;
-  };
-  const int o = t.x0;
-  if (x0 == 0) put(0 - o, mean(0 - o, 0 - o, std::min(1, w - 1) - o));
-  texture_run(r0, r1, r2, I, R, G, dst, std::max(x0, 1) - o, std::min(x1, w - 1) - o);
-  if (x1 == w && w > 1) put(w - 1 - o, mean(w - 2 - o, w - 1 - o, w - 1 - o));
 }
 
 }  // namespace epichead::vision

@@ -55,20 +55,8 @@ class WindowImage {
   int tiles() const { return tiles_x_ * tiles_y_; }
 
  private:
-  // Where a tile's intermediate planes are: row y, column x of the image at at(y, x).
-  struct TileScratch {
-    int x0 = 0, y0 = 0, stride = 0;
-    float* intensity = nullptr;
-    float* chroma_r = nullptr;
-    float* chroma_g = nullptr;
-    float* gradient = nullptr;
-    std::size_t at(int y, int x) const { return static_cast<std::size_t>(y - y0) * stride + (x - x0); }
-  };
   void keep_bytes(const cv::Mat& frame);
   void prepare_tile(int tx, int ty) const;
-  void colour_row(const TileScratch& t, int y, int x0, int x1) const;
-  void gradient_row(const TileScratch& t, int y, int x0, int x1) const;
-  void interleave_row(const TileScratch& t, int y, int x0, int x1) const;
 
   int width_px_ = 0, height_px_ = 0;
   bool colour_ = false;
