@@ -357,7 +357,10 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
-    if (!pending_init_) last_applied_t_s_ = t_s;
+    if (!pending_init_) {
+      last_applied_t_s_ = t_s;
+      seen_vision_ = true;  // restarted from a tracked pose, not a seed
+    }
     init_t_s_ = t_s;
     return r;
   }
