@@ -132,7 +132,6 @@ class ImuPredictor final : public TrackPredictor {
     pending_init_ = true;
     reset_done_ = false;
     arbiter_.clear();
-    seen_vision_ = false;
     last_applied_t_s_ = -INFINITY;  // a detected pose is not a tracked one
     ++detection_restarts_;
   }
@@ -153,7 +152,7 @@ class ImuPredictor final : public TrackPredictor {
     }
     last_good_ = report.cam_T_obj;
     last_good_t_s_ = t_s;
-    if (!seen_vision_ && !reset_done_ && !vision::strongly_supported(report)) {
+    if (!given_tracked_pose() && !reset_done_ && !vision::strongly_supported(report)) {
       // Seeded (init.csv, a detection) but not yet given a pose, the filter is carried by the
       // IMU alone, and with its velocity unknown its position spreads. Once its 1-sigma across
       // the view is wider than a line window, its prediction cannot place the windows: a pose
@@ -214,11 +213,11 @@ class ImuPredictor final : public TrackPredictor {
     if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
     const fusion::VisionResult& r = a.final();
     if (fusion::supersedes_start_pose(r.verdict)) pending_init_ = false;
-    if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) {
-      last_applied_t_s_ = t_s;
-      seen_vision_ = true;
-    }
+    if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) last_applied_t_s_ = t_s;
   }
+  // Whether the filter has taken a tracked pose since its seed (init.csv, a detection) or its
+  // reset after a long loss.
+  bool given_tracked_pose() const { return last_applied_t_s_ > -INFINITY; }
   // The prediction's 1-sigma position across the line of sight (the larger of x and y), in
   // pixels at its depth; 0 before the filter starts.
   double predicted_sigma_px(double t_s) {
@@ -357,10 +356,7 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
-    if (!pending_init_) {
-      last_applied_t_s_ = t_s;
-      seen_vision_ = true;  // restarted from a tracked pose, not a seed
-    }
+    if (!pending_init_) last_applied_t_s_ = t_s;
     init_t_s_ = t_s;
     return r;
   }
@@ -372,10 +368,9 @@ class ImuPredictor final : public TrackPredictor {
   double fx_px_ = 0;  // the camera's focal length (predicted_sigma_px)
   Eigen::Isometry3d last_good_;
   double last_good_t_s_ = 0, init_t_s_ = 0;
-  double last_applied_t_s_ = -INFINITY;  // the filter's newest vision pose (applied or seeding it)
+  double last_applied_t_s_ = -INFINITY;  // the filter's newest tracked pose (applied or seeding it); -inf: none since its seed or reset
   bool pending_init_ = false, reset_done_ = false;
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
-  bool seen_vision_ = false;     // the filter has taken a tracked pose since its seed (init.csv, a detection)
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
   int weak_reacquisitions_ = 0, weak_poses_unplaceable_ = 0, detection_restarts_ = 0;
   fusion::VisionArbiter arbiter_;  // who is wrong when vision and the filter disagree
