@@ -316,3 +316,22 @@ TEST_CASE("hypothesis places are shared out over the distances, what one leaves 
   CHECK(hypothesis_places(distance_of, 4, 0, none_lie).empty());
   CHECK(hypothesis_places({}, 4, 8, none_lie).empty());
 }
+
+TEST_CASE("symmetric turn: the turn between two poses as far as an outline can tell, a twin's none, a body of revolution's axis only") {
+  const auto turns = model_symmetries(box(0.165, 0.068, 0.08));
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(-1.9, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ())).toRotationMatrix();
+  const Eigen::Matrix3d turned20 = R * Eigen::AngleAxisd(20 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  CHECK(symmetric_turn_rad(R, turned20, turns) * 180 / M_PI == Approx(20).margin(1e-9));
+  // A box's half-turn twin draws the same outline: no turn between them.
+  REQUIRE_FALSE(turns.empty());
+  const Eigen::Matrix3d twin = R * turns.front().linear();
+  CHECK(Eigen::AngleAxisd(R.transpose() * twin).angle() * 180 / M_PI > 170);
+  CHECK(symmetric_turn_rad(R, twin, turns) < 1e-9);
+  CHECK(symmetric_turn_rad(R, twin, {}) * 180 / M_PI > 170);  // without its symmetries it is a half turn
+  // A can's turn about its axis (its model z) is no outline's to tell; a tilt of the axis is.
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix3d about_axis = R * Eigen::AngleAxisd(1.0, axis).toRotationMatrix();
+  CHECK(symmetric_turn_rad(R, about_axis, {}, axis) < 1e-9);
+  const Eigen::Matrix3d tilted = R * Eigen::AngleAxisd(15 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  CHECK(symmetric_turn_rad(R, tilted, {}, axis) * 180 / M_PI == Approx(15).margin(1e-9));
+}

@@ -55,6 +55,11 @@ std::vector<std::string> Detector::Impl::classes_for(const DetectionPrior& prior
       const Eigen::Matrix3d R = detail::look_rotation(views[static_cast<std::size_t>(s.view)], rolls_rad[static_cast<std::size_t>(s.roll)]);
       if (angle_deg(R * *prior.up_obj, *prior.up_cam) > options.up_tolerance_deg + half_fov_deg) continue;
     }
+    if (prior.cam_R_obj) {
+      const auto& s = specs[static_cast<std::size_t>(list.front())];
+      const Eigen::Matrix3d R = detail::look_rotation(views[static_cast<std::size_t>(s.view)], rolls_rad[static_cast<std::size_t>(s.roll)]);
+      if (!turned_near(R, prior, template_turn_slack_deg() + half_fov_deg)) continue;
+    }
     ids.push_back(id);
   }
   return ids;
@@ -94,6 +99,7 @@ std::vector<Eigen::Isometry3d> Detector::Impl::hypotheses(const std::vector<cv::
     T.linear() = align * T.linear();
     T.translation() = ray * s.distance_m - T.linear() * centre_obj;
     if (prior.up_cam && prior.up_obj && angle_deg(T.linear() * *prior.up_obj, *prior.up_cam) > options.up_tolerance_deg) continue;
+    if (!turned_near(T.linear(), prior, template_turn_slack_deg())) continue;
     ++taken[static_cast<std::size_t>(s.distance)];
     visibility.compute(T, visible);
     const detail::EdgeSupport support = detail::edge_support(gradients, visible, quick);
@@ -241,7 +247,8 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
     const auto t_near = Clock::now();
     DetectionHypothesis near = d.refine(*prior.near_cam_T_obj, 0.0f);
     result.refine_ms += ms_since(t_near);
-    if (d.verified(near)) {
+    if (prior.cam_R_obj) near.turn_off_deg = d.turn_off_deg(near.cam_T_obj.linear(), prior);
+    if (d.verified(near) && d.turned_near(near.cam_T_obj.linear(), prior, 0)) {
       result.best = near;
       result.found = true;
       result.hypotheses.push_back(near);
@@ -265,9 +272,16 @@ std::expected<DetectionResult, std::string> Detector::detect(const cv::Mat& fram
                    [](const DetectionHypothesis& a, const DetectionHypothesis& b) { return a.score > b.score; });
   result.refine_ms += ms_since(t1);
   for (DetectionHypothesis& h : result.hypotheses) d.choose_symmetric(h, prior);
+  if (prior.cam_R_obj) {
+    // A pose turned away from the known orientation is no candidate at all, whatever its score:
+    // the search was narrowed to templates near it, and refinement can still turn onto clutter.
+    for (DetectionHypothesis& h : result.hypotheses) h.turn_off_deg = d.turn_off_deg(h.cam_T_obj.linear(), prior);
+    std::stable_partition(result.hypotheses.begin(), result.hypotheses.end(),
+                          [&](const DetectionHypothesis& h) { return d.turned_near(h.cam_T_obj.linear(), prior, 0); });
+  }
   if (!result.hypotheses.empty()) {
     result.best = result.hypotheses.front();
-    result.found = d.verified(result.best);
+    result.found = d.verified(result.best) && d.turned_near(result.best.cam_T_obj.linear(), prior, 0);
   }
   return result;
 }

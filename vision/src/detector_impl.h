@@ -4,6 +4,7 @@
 // refinement and verification, detect()).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <string>
@@ -14,6 +15,7 @@
 #include "edge_support.h"
 #include "epichead/vision/detector.h"
 #include "epichead/vision/model_symmetry.h"
+#include "epichead/vision/revolution_axis.h"
 #include "template_cache.h"
 
 namespace epichead::vision {
@@ -29,7 +31,9 @@ struct Detector::Impl {
   Impl(const CadModel& m, const Camera& c, const DetectorOptions& o, const ModelTrackerOptions& t)
       : model_storage(m), model(&model_storage), camera(c), options(o), pull(model_storage, c, wide(t)),
         tracker(model_storage, c, without_outline_colours(t)), visibility(model_storage, c, whole_circles(t.visibility)),
-        symmetries(model_symmetries(m)) {}
+        symmetries(model_symmetries(m)) {
+    if (const auto axis = find_revolution_axis(m)) free_axis_obj = axis->direction_obj.normalized();
+  }
 
   // A hypothesis can be off by more than the outline colours' margins, and then draws the
   // background into the object's histogram: on the real tea box video the colours pulled the
@@ -86,6 +90,8 @@ struct Detector::Impl {
   // The model's own symmetries (model_symmetry.h): poses that differ by one draw the same
   // outline, so the search cannot choose among them; the prior can (choose_symmetric).
   std::vector<Eigen::Isometry3d> symmetries;
+  // A body of revolution's axis (revolution_axis.h): a turn about it is no outline's to tell.
+  std::optional<Eigen::Vector3d> free_axis_obj;
 
   void project_outline(const Eigen::Isometry3d& T, std::vector<Eigen::Vector2d>& px) const {
     px.clear();
@@ -126,6 +132,20 @@ struct Detector::Impl {
   // A can found again after a cover is otherwise as likely upside down (issue 19).
   void choose_symmetric(DetectionHypothesis& h, const DetectionPrior& prior) const;
   bool verified(const DetectionHypothesis& h) const { return failed_detection_tests(h, options) == 0; }
+  // With the prior's orientation: how far cam_R_obj is turned from it (symmetric_turn_rad), deg.
+  double turn_off_deg(const Eigen::Matrix3d& cam_R_obj, const DetectionPrior& prior) const {
+    return symmetric_turn_rad(cam_R_obj, *prior.cam_R_obj, symmetries, free_axis_obj) * 180.0 / M_PI;
+  }
+  // Whether a pose turned cam_R_obj may be the prior's, `slack_deg` beyond its tolerance (true
+  // without an orientation in the prior).
+  bool turned_near(const Eigen::Matrix3d& cam_R_obj, const DetectionPrior& prior, double slack_deg) const {
+    return !prior.cam_R_obj || turn_off_deg(cam_R_obj, prior) <= prior.turn_tolerance_deg + slack_deg;
+  }
+  // The farthest a pose's turn can be from its nearest template's: half the view grid's spacing
+  // (an icosahedron's 63 deg edge halved per subdivision) and half the in-plane step.
+  double template_turn_slack_deg() const {
+    return 0.5 * (63.4 / std::pow(2.0, options.view_subdivisions) + options.in_plane_step_deg);
+  }
 };
 
 

@@ -103,4 +103,19 @@ Eigen::Isometry3d symmetric_upright(const Eigen::Isometry3d& cam_T_obj, const st
   return cheapest(cam_T_obj, symmetries, [&](const Eigen::Isometry3d& T) { return -(T.linear() * up_obj).dot(up_cam); });
 }
 
+double symmetric_turn_rad(const Eigen::Matrix3d& cam_R_a, const Eigen::Matrix3d& cam_R_b,
+                          const std::vector<Eigen::Isometry3d>& symmetries, const std::optional<Eigen::Vector3d>& free_axis_obj) {
+  auto turn = [&](const Eigen::Matrix3d& b) {
+    if (free_axis_obj) {
+      const Eigen::Vector3d u = cam_R_a * *free_axis_obj, v = b * *free_axis_obj;
+      return std::atan2(u.cross(v).norm(), u.dot(v));
+    }
+    return Eigen::AngleAxisd(cam_R_a.transpose() * b).angle();
+  };
+  double best = turn(cam_R_b);
+  for (const auto& S : symmetries) best = std::min(best, turn(cam_R_b * S.linear()));
+  return best;
+}
+
 }  // namespace epichead::vision
+

@@ -76,7 +76,8 @@ std::string to_string(TrackReason reasons) {
       {TrackReason::HighResidual, "high_residual"}, {TrackReason::Jump, "jump"},
       {TrackReason::Reacquired, "reacquired"},
       {TrackReason::AgainstGravity, "against_gravity"},
-      {TrackReason::AgainstImageMotion, "against_image_motion"}};
+      {TrackReason::AgainstImageMotion, "against_image_motion"},
+      {TrackReason::AgainstCarriedTurn, "against_carried_turn"}};
   std::string s;
   for (const auto& [bit, name] : names) {
     if (!has(reasons, bit)) continue;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <expected>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -96,6 +97,9 @@ struct DetectionHypothesis {
   // edge supports on less than a quarter of their length, and the lowest support of one.
   double unsupported_edge_share = 0;
   double weakest_edge_support = 1;
+  // With DetectionPrior::cam_R_obj: how far the pose is turned from it (symmetric_turn_rad), deg;
+  // NaN without.
+  double turn_off_deg = std::numeric_limits<double>::quiet_NaN();
   TrackStatus status = TrackStatus::Lost;  // of the last refinement step
 };
 
@@ -129,6 +133,13 @@ struct DetectionPrior {
   // or else the one that puts up_obj nearest up_cam. Unlike near_cam_T_obj it does not narrow
   // the search (a recheck of the tracked pose).
   std::optional<Eigen::Isometry3d> orient_like;
+  // The object's orientation in the camera frame, known within turn_tolerance_deg (the gyro
+  // carried it across a loss, fusion/carried_orientation.h): only templates turned near it are
+  // matched, and a pose turned farther (as far as the model's symmetries and a body of
+  // revolution's free turn let any outline tell) is not found. Clutter's outlines, turned any way,
+  // then rarely pass (late_entry: 16-105 deg off, on the wall beside the package).
+  std::optional<Eigen::Matrix3d> cam_R_obj;
+  double turn_tolerance_deg = 0;
 };
 
 class Detector {

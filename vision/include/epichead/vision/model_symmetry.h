@@ -3,6 +3,7 @@
 // poses that differ by one of them draw the same wire-frame, so neither the tracker nor
 // detection can tell them apart without texture. Scoring removes them as it removes the free
 // turn of a body of revolution.
+#include <optional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -25,5 +26,13 @@ Eigen::Isometry3d symmetric_nearest(const Eigen::Isometry3d& cam_T_obj, const st
 // frame (up_cam): gravity's choice when there is no prior pose.
 Eigen::Isometry3d symmetric_upright(const Eigen::Isometry3d& cam_T_obj, const std::vector<Eigen::Isometry3d>& symmetries,
                                     const Eigen::Vector3d& up_obj, const Eigen::Vector3d& up_cam);
+
+// The smallest turn (rad) between cam_R_a and cam_R_b or any of its equivalents cam_R_b * S (S
+// among `symmetries`): how far two poses are turned apart as far as any outline can tell. With
+// free_axis_obj (a body of revolution, revolution_axis.h; unit, model frame) only the axis's own
+// direction counts, since the turn about it is no pose's to tell.
+double symmetric_turn_rad(const Eigen::Matrix3d& cam_R_a, const Eigen::Matrix3d& cam_R_b,
+                          const std::vector<Eigen::Isometry3d>& symmetries,
+                          const std::optional<Eigen::Vector3d>& free_axis_obj = std::nullopt);
 
 }  // namespace epichead::vision

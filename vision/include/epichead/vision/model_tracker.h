@@ -51,6 +51,9 @@ enum class TrackReason : std::uint32_t {
                              // the down the accelerometer measures (a wrong lock; fusion/learnt_gravity.h)
   AgainstImageMotion = 1u << 8,  // set by the caller without an IMU: the pose puts the object away from
                                  // where the frame's own motion shows it (a wrong lock; tools/image_motion.h)
+  AgainstCarriedTurn = 1u << 9,  // set by the caller with an IMU, while its filter has forgotten its state after
+                                 // a long loss: the pose is turned away from the orientation the gyro carried
+                                 // (fusion/carried_orientation.h)
 };
 constexpr TrackReason operator|(TrackReason a, TrackReason b) {
   return static_cast<TrackReason>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
