@@ -306,6 +306,7 @@ struct TrackCounts {
   int fallback_frames = 0;  // frames measured from the vision-only extrapolation
   int against_gravity = 0;  // tracked poses taken as lost: their tilt contradicts the accelerometer
   int against_image_motion = 0;  // tracked poses that contradicted the frame's motion, measured again
+  int against_carried_turn = 0;  // tracked poses taken as lost: turned away from the gyro's carried orientation
 };
 
 // The tracked pose's tilt against the accelerometer's down, for report.json (measured before the
@@ -320,6 +321,17 @@ std::optional<double> check_tilt(TrackPredictor& predictor, double t_s, FrameRep
     ++counts.against_gravity;
   }
   return error_rad;
+}
+
+// With the IMU, after its filter forgot its state in a long loss: a tracked pose turned away from
+// the orientation the gyro carried is a re-lock from the prediction onto clutter (held-out
+// late_entry 278: 25 deg off, on the wall beside the package, as it came into view): lost, so that
+// detection runs, narrowed to that orientation.
+void check_carried_turn(TrackPredictor& predictor, double t_s, FrameReport& report, TrackCounts& counts) {
+  if (report.status == TrackStatus::Lost || !predictor.against_carried_turn(t_s, report.cam_T_obj)) return;
+  report.status = TrackStatus::Lost;
+  report.reasons = report.reasons | vision::TrackReason::AgainstCarriedTurn;
+  ++counts.against_carried_turn;
 }
 
 // report.json's summary (per-frame entries and acquisition are added by the caller).
@@ -344,6 +356,7 @@ nlohmann::json report_json(const TrackArgs& args, std::size_t frames, const Trac
   j["fallback_frames"] = c.fallback_frames;
   j["against_gravity_frames"] = c.against_gravity;
   j["against_image_motion_frames"] = c.against_image_motion;
+  j["against_carried_turn_frames"] = c.against_carried_turn;
   if (tracker.free_turn()) {
     const auto& a = *tracker.free_turn();
     j["free_turn_axis"] = {{"point_obj", {a.point_obj.x(), a.point_obj.y(), a.point_obj.z()}},
@@ -445,6 +458,7 @@ int run_track(const TrackArgs& args) {
     }
     tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
     std::optional<double> tilt_error_rad = check_tilt(**predictor, entry.t_s, report, counts);
+    check_carried_turn(**predictor, entry.t_s, report, counts);
     if (use_image_motion) counts.against_image_motion += image_motion.check(tracker, image, report);
     if (auto ok = acquisition.after_tracking(*frame, image, entry.t_s, predicted, tracker, **predictor, report); !ok)
       return fail(cmd, ok.error());
@@ -461,6 +475,7 @@ int run_track(const TrackArgs& args) {
       fallback = (*predictor)->fallback(entry.t_s);
       tracker.track(image, predicted, fallback ? &*fallback : nullptr, report);
       tilt_error_rad = check_tilt(**predictor, entry.t_s, report, counts);
+      check_carried_turn(**predictor, entry.t_s, report, counts);
       counts.fallback_frames += report.used_fallback;
       (*predictor)->observe(entry.t_s, report);
       switch_undone = true;

@@ -52,10 +52,13 @@ class TrackAcquisition {
   bool after_frame(vision::TrackStatus status);
   // Detection after a loss, near `predicted` first. Counts the re-acquisition when found.
   // With `upright` (the IMU's learnt down) the search keeps upright poses only, and skips the
-  // predicted pose when that tilts the object away.
-  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, double t_s,
-                                                                          const Eigen::Isometry3d& predicted,
-                                                                          const std::optional<Upright>& upright = {});
+  // predicted pose when that tilts the object away. With the orientation the gyro carried since
+  // the filter last knew it (TrackPredictor::carried_orientation) only poses turned within
+  // fusion::carried_turn_tolerance_deg of it are found, and the found pose is tracked once on `image` to
+  // see that it stays so: refinement can still turn it onto clutter.
+  std::expected<std::optional<Eigen::Isometry3d>, std::string> find_again(const cv::Mat& frame, const vision::WindowImage& image,
+                                                                          double t_s, const Eigen::Isometry3d& predicted,
+                                                                          const TrackPredictor& predictor);
   // After the frame's tracking step (report): detection when the object has been lost for a few
   // frames (near `predicted` first), and the provisional start's recheck. When either finds a
   // pose, the tracker and the predictor restart from it and the frame is measured again.
@@ -78,7 +81,10 @@ class TrackAcquisition {
   std::expected<std::optional<Eigen::Isometry3d>, std::string> detect(const cv::Mat& frame, double t_s,
                                                                       const std::optional<Eigen::Isometry3d>& near,
                                                                       const std::optional<Eigen::Isometry3d>& orient_like = {},
-                                                                      const std::optional<Upright>& upright = {});
+                                                                      const std::optional<Upright>& upright = {},
+                                                                      const std::optional<fusion::OrientationPrior>& carried = {});
+  // A found pose levelled to the IMU's down (geometry/level_to_up.h), as the tracker takes it.
+  Eigen::Isometry3d levelled(const Eigen::Isometry3d& found, const std::optional<Upright>& upright) const;
   // A pose found by detection (start, re-acquisition, switch) is taken at t_s: provisional from
   // now, no lead carried over from rechecks of the pose it replaces, and a new lock's beginning.
   void took_detected(double t_s);
@@ -92,6 +98,8 @@ class TrackAcquisition {
   vision::FrameReport trial_report_;
   int start_frame_ = -1, start_attempts_ = 0;
   int lost_run_ = 0, losses_ = 0, reacquired_ = 0, detections_ = 0;
+  int detections_turned_ = 0;  // detections narrowed to a carried orientation
+  int found_turned_away_ = 0;  // of those, found poses refused: tracked, they turned away from it
   bool in_loss_ = false;
   RecheckSchedule rechecks_due_;
   RecheckSwitch switch_;

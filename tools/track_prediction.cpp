@@ -10,6 +10,7 @@
 #include "epichead/fusion/time_offset_estimator.h"
 #include "epichead/fusion/vision_arbiter.h"
 #include "epichead/vision/constant_velocity.h"
+#include "epichead/vision/model_symmetry.h"
 #include "epichead/vision/pose_estimator.h"
 #include "epichead/vision/revolution_axis.h"
 
@@ -105,10 +106,14 @@ class ImuPredictor final : public TrackPredictor {
                std::optional<fusion::TimeOffsetEstimator> estimator)
       : options_(options), predictor_(std::move(predictor)), imu_(&seq.imu()), offset_s_(options.imu_time_offset_s),
         fx_px_(seq.camera().intrinsics().fx_px), last_good_(seq.init().cam_T_obj), arbiter_(options.gate_chi2),
-        vision_only_(seq.init().t_s, seq.init().cam_T_obj), estimator_(std::move(estimator)) {
+        vision_only_(seq.init().t_s, seq.init().cam_T_obj), carried_(options.mount.cam_R_imu, fusion::CarriedOrientationNoise{}),
+        last_good_turned_(options.mount.cam_R_imu, fusion::CarriedOrientationNoise{}),
+        estimator_(std::move(estimator)) {
+    symmetries_ = vision::model_symmetries(seq.model());
     // The initial pose seeds the filter like a vision result with a loose covariance.
     pending_init_ = true;
     init_t_s_ = seq.init().t_s;
+    note_good(init_t_s_, last_good_);
   }
   Eigen::Isometry3d predict(double t_s) override {
     feed_until(t_s);
@@ -116,10 +121,26 @@ class ImuPredictor final : public TrackPredictor {
       const auto r = predictor_.add_vision(init_t_s_, last_good_, vision::initial_pose_covariance());
       pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
       seeded_by_init_ = !pending_init_;
+      // init.csv's orientation is the user's word; a detection's seed is not (the first pose
+      // tracked from it is, once the filter applies it).
+      if (seeded_by_init_ && seed_given_) carry(init_t_s_);
     }
     if (auto p = predictor_.predict(t_s)) return p->cam_T_obj;
     ++fallbacks_;
-    return last_good_;
+    return last_good_turned(t_s);
+  }
+  // Without a filter (reset after a long loss, or not yet started): the last good pose turned as
+  // the gyro says the camera turned since, about the camera's centre. A head or a wheeled robot
+  // turning onto the object moves its camera little beside the turn; the pose as it was would
+  // leave the windows where the object was in the image before the turn (held-out late_entry).
+  Eigen::Isometry3d last_good_turned(double t_s) const {
+    const auto turned = last_good_turned_.at(t_s);
+    if (!turned) return last_good_;
+    const Eigen::Matrix3d turn = turned->cam_R_obj * last_good_.linear().transpose();
+    Eigen::Isometry3d T = last_good_;
+    T.linear() = turned->cam_R_obj;
+    T.translation() = turn * last_good_.translation();
+    return T;
   }
   std::optional<Eigen::Isometry3d> fallback(double t_s) override { return vision_only_.predict(t_s); }
   void restart(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
@@ -127,12 +148,13 @@ class ImuPredictor final : public TrackPredictor {
     // time then replaces it (observe()).
     predictor_.reset();
     vision_only_.restart(t_s, cam_T_obj);
-    last_good_ = cam_T_obj;
-    last_good_t_s_ = init_t_s_ = t_s;
+    note_good(t_s, cam_T_obj);
+    init_t_s_ = t_s;
     pending_init_ = true;
     reset_done_ = false;
     arbiter_.clear();
     last_applied_t_s_ = -INFINITY;  // a detected pose is not a tracked one
+    seed_given_ = false;
     ++detection_restarts_;
   }
   void observe(double t_s, const vision::FrameReport& report) override {
@@ -150,8 +172,7 @@ class ImuPredictor final : public TrackPredictor {
       }
       return;
     }
-    last_good_ = report.cam_T_obj;
-    last_good_t_s_ = t_s;
+    note_good(t_s, report.cam_T_obj);
     if (!given_tracked_pose() && !reset_done_ && !vision::strongly_supported(report)) {
       // Seeded (init.csv, a detection) but not yet given a pose, the filter is carried by the
       // IMU alone, and with its velocity unknown its position spreads. Once its 1-sigma across
@@ -213,7 +234,25 @@ class ImuPredictor final : public TrackPredictor {
     if (restart) verdict_["after_restart"] = fusion::to_string(a.after_restart.verdict);
     const fusion::VisionResult& r = a.final();
     if (fusion::supersedes_start_pose(r.verdict)) pending_init_ = false;
-    if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) last_applied_t_s_ = t_s;
+    if (r.verdict == fusion::VisionVerdict::Initialised || r.verdict == fusion::VisionVerdict::Applied) {
+      last_applied_t_s_ = t_s;
+      carry(t_s);
+    }
+  }
+  std::optional<fusion::OrientationPrior> carried_orientation(double t_s) const override { return carried_.at(t_s); }
+  bool turned_from_carried(double t_s, const Eigen::Isometry3d& cam_T_obj) const override {
+    const auto carried = carried_.at(t_s);
+    if (!carried) return false;
+    const double off_rad = vision::symmetric_turn_rad(cam_T_obj.linear(), carried->cam_R_obj, symmetries_,
+                                                      options_.gravity_check.free_turn_axis_obj);
+    return off_rad * 180 / std::numbers::pi > fusion::carried_turn_tolerance_deg(*carried);
+  }
+  bool against_carried_turn(double t_s, const Eigen::Isometry3d& cam_T_obj) override {
+    feed_until(t_s);
+    if (predictor_.predict(t_s)) return false;  // the filter runs: its gate judges the pose
+    if (!turned_from_carried(t_s, cam_T_obj)) return false;
+    ++against_carried_turn_;
+    return true;
   }
   // Whether the filter has taken a tracked pose since its seed (init.csv, a detection) or its
   // reset after a long loss.
@@ -291,6 +330,7 @@ class ImuPredictor final : public TrackPredictor {
             {"restarts_from_fallback", arbiter_.counters().fallback},
             {"weak_poses_after_loss", weak_reacquisitions_},
             {"weak_poses_unplaceable", weak_poses_unplaceable_},
+            {"poses_against_carried_turn", against_carried_turn_},
             {"restarts_after_supported_gated", arbiter_.counters().supported_gated},
             {"restarts_after_agreeing_gated", arbiter_.counters().agreeing_gated},
             {"restarts_from_detection", detection_restarts_},
@@ -319,6 +359,8 @@ class ImuPredictor final : public TrackPredictor {
       s.gyro_radps = imu[next_].gyro_radps;
       s.accel_mps2 = imu[next_].accel_mps2;
       predictor_.add_imu(s);
+      carried_.add_gyro(s.t_s - offset_s_, s.gyro_radps);
+      last_good_turned_.add_gyro(s.t_s - offset_s_, s.gyro_radps);
       // The estimator sees the gyro ahead of the camera by the search range, so every
       // candidate offset has samples.
       ++next_;
@@ -356,9 +398,33 @@ class ImuPredictor final : public TrackPredictor {
     feed_until(t_s);
     const auto r = predictor_.add_vision(t_s, report.cam_T_obj, report.covariance);
     pending_init_ = r.verdict != fusion::VisionVerdict::Initialised && r.verdict != fusion::VisionVerdict::Applied;
-    if (!pending_init_) last_applied_t_s_ = t_s;
+    if (!pending_init_) {
+      last_applied_t_s_ = t_s;
+      carry(t_s);
+    }
     init_t_s_ = t_s;
     return r;
+  }
+  void note_good(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+    last_good_ = cam_T_obj;
+    last_good_t_s_ = t_s;
+    if (const auto x = predictor_.state()) gyro_bias_radps_ = x->gyro_bias_radps;
+    last_good_turned_.set(t_s, cam_T_obj.linear(), 0, gyro_bias_radps_);
+  }
+  // The filter's orientation at t_s (just updated) is what the gyro carries from here: its 1-sigma
+  // the largest of its rotation block's, without a body of revolution's free turn, which no
+  // outline can contradict (vision::symmetric_turn_rad leaves it out too).
+  void carry(double t_s) {
+    const auto p = predictor_.predict(t_s);
+    const auto x = predictor_.state();
+    if (!p || !x) return;
+    Eigen::Matrix3d P = p->covariance.bottomRightCorner<3, 3>();
+    if (const auto& axis = options_.gravity_check.free_turn_axis_obj) {
+      const Eigen::Vector3d a = (p->cam_T_obj.linear() * *axis).normalized();
+      const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
+      P = across * P * across;
+    }
+    carried_.set(t_s, p->cam_T_obj.linear(), std::sqrt(std::max(0.0, P.diagonal().maxCoeff())), x->gyro_bias_radps);
   }
   fusion::PredictorOptions options_;
   fusion::Predictor predictor_;
@@ -371,13 +437,18 @@ class ImuPredictor final : public TrackPredictor {
   double last_applied_t_s_ = -INFINITY;  // the filter's newest tracked pose (applied or seeding it); -inf: none since its seed or reset
   bool pending_init_ = false, reset_done_ = false;
   bool seeded_by_init_ = false;  // the filter's only pose so far is the start pose (init.csv)
+  bool seed_given_ = true;       // the start pose is init.csv's, not a detection's
   int lost_ = 0, resets_ = 0, fallbacks_ = 0;
-  int weak_reacquisitions_ = 0, weak_poses_unplaceable_ = 0, detection_restarts_ = 0;
+  int weak_reacquisitions_ = 0, weak_poses_unplaceable_ = 0, detection_restarts_ = 0, against_carried_turn_ = 0;
+  std::vector<Eigen::Isometry3d> symmetries_;  // the model's (vision/model_symmetry.h), for against_carried_turn()
   fusion::VisionArbiter arbiter_;  // who is wrong when vision and the filter disagree
   nlohmann::json verdict_;  // frame_verdict()
   std::optional<fusion::VisionVerdict> first_verdict_;  // verdict()
   vision::ConstantVelocity vision_only_;  // the second opinion when the IMU's prediction loses the object
   NisStats nis_;
+  fusion::CarriedOrientation carried_;  // the orientation kept across a reset (carried_orientation())
+  fusion::CarriedOrientation last_good_turned_;  // last_good_'s, turned by the gyro since (last_good_turned())
+  Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();  // the filter's newest estimate
   // Offset estimation (auto).
   static constexpr double kEstimatorLeadS = 0.15;
   std::optional<fusion::TimeOffsetEstimator> estimator_;

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "epichead/fusion/carried_orientation.h"
 #include "epichead/fusion/predictor.h"
 #include "epichead/vision/model_tracker.h"
 #include "epichead/vision/offline/sequence.h"
@@ -72,6 +73,28 @@ class TrackPredictor {
   virtual std::optional<Upright> upright(double t_s) const {
     (void)t_s;
     return std::nullopt;
+  }
+  // With the IMU: the object's orientation the gyro carried from when the filter last knew it
+  // (fusion/carried_orientation.h), kept across the filter's reset after a long loss, for
+  // detection to look for; nothing otherwise, or before the filter knew it.
+  virtual std::optional<fusion::OrientationPrior> carried_orientation(double t_s) const {
+    (void)t_s;
+    return std::nullopt;
+  }
+  // With the IMU: true when `cam_T_obj`, tracked at t_s, is turned from carried_orientation(t_s)
+  // by more than fusion::carried_turn_tolerance_deg (as far as the model's symmetries and a body of
+  // revolution's free turn let an outline tell); false without one.
+  virtual bool turned_from_carried(double t_s, const Eigen::Isometry3d& cam_T_obj) const {
+    (void)t_s;
+    (void)cam_T_obj;
+    return false;
+  }
+  // ... and the filter has forgotten its state after a long loss, so nothing else judges the pose:
+  // a re-lock on clutter from a stale prediction, to be taken as lost. Counted.
+  virtual bool against_carried_turn(double t_s, const Eigen::Isometry3d& cam_T_obj) {
+    (void)t_s;
+    (void)cam_T_obj;
+    return false;
   }
   // Detection found the object again at t_s (after a loss): predictions restart from this pose
   // at rest, as from init.csv.
