@@ -35,6 +35,7 @@ nlohmann::json summary_json(const head::OnboardSummary& s) {
                                           {"losses", s.losses},
                                           {"reacquisitions", s.reacquisitions},
                                           {"levelled_to_gravity", s.levelled_to_gravity},
+                                          {"found_turned_away_from_carried", s.found_turned_away_from_carried},
                                           {"against_gravity", s.against_gravity},
                                           {"first_detection_t_s", s.first_detection_t_s},
                                           {"detect_ms_max", s.detect_ms_max}}},

@@ -12,6 +12,7 @@
 
 #include "epichead/firmware_iface/can_ids.h"
 #include "epichead/firmware_iface/protocol.h"
+#include "epichead/fusion/carried_orientation.h"
 #include "epichead/head/target_observation.h"
 #include "epichead/vision/constant_velocity.h"
 #include "epichead/vision/model_centre.h"
@@ -48,7 +49,9 @@ struct OnboardLoop::Impl {
         vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
         arbiter(o.predictor.gate_chi2),
         controller(std::move(ctrl)), target_point_obj(vision::model_centre(m)), imu_clock(clock_sync_options(o)),
-        recorder(std::move(rec)) {}
+        recorder(std::move(rec)), carried(o.predictor.mount.cam_R_imu, fusion::CarriedOrientationNoise{}) {
+    if (const auto axis = vision::find_revolution_axis(m)) free_axis_obj = axis->direction_obj.normalized();
+  }
 
   const vision::CadModel* model;
   vision::Camera camera;
@@ -63,6 +66,11 @@ struct OnboardLoop::Impl {
   ImuFrameAssembler assembler;
   std::unique_ptr<Recorder> recorder;
   std::atomic<bool> stop_requested{false};
+  // The object's orientation the gyro carries from the filter's last applied pose (or the start
+  // pose given): detection after a loss looks for the object turned so (as `track` does).
+  fusion::CarriedOrientation carried;
+  std::optional<Eigen::Vector3d> free_axis_obj;  // a body of revolution's: its turn is not carried
+  bool init_given = false;  // the pending start pose is the user's (set_initial_pose), not a detection's
 
   // Initial pose and the last good one: where windows go while the predictor has nothing.
   Eigen::Isometry3d last_good = Eigen::Isometry3d::Identity();
@@ -146,6 +154,22 @@ struct OnboardLoop::Impl {
     if (v == fusion::ImuVerdict::Accepted || v == fusion::ImuVerdict::Buffered) ++summary.imu_samples;
     else ++summary.imu_rejected;
     if (std::isfinite(s.gyro_radps.sum())) gyro = GyroReading{s.t_s, s.gyro_radps};
+    if (v == fusion::ImuVerdict::Accepted || v == fusion::ImuVerdict::Buffered) carried.add_gyro(s.t_s, s.gyro_radps);
+  }
+
+  // The filter's orientation at t_s (just updated) is what the gyro carries from here; its 1-sigma
+  // the largest of its rotation block's, without a body of revolution's free turn.
+  void carry(double t_s) {
+    const auto p = predictor.predict(t_s);
+    const auto x = predictor.state();
+    if (!p || !x) return;
+    Eigen::Matrix3d P = p->covariance.bottomRightCorner<3, 3>();
+    if (free_axis_obj) {
+      const Eigen::Vector3d a = (p->cam_T_obj.linear() * *free_axis_obj).normalized();
+      const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
+      P = across * P * across;
+    }
+    carried.set(t_s, p->cam_T_obj.linear(), std::sqrt(std::max(0.0, P.diagonal().maxCoeff())), x->gyro_bias_radps);
   }
 
   // A new camera frame, if one is ready: to the vision stage with the pose predicted at its
@@ -172,6 +196,7 @@ struct OnboardLoop::Impl {
     if (init_pending) {
       const auto v = predictor.add_vision(init_t_s, last_good, vision::initial_pose_covariance()).verdict;
       init_pending = v != fusion::VisionVerdict::Initialised && v != fusion::VisionVerdict::Applied;
+      if (!init_pending && init_given) carry(init_t_s);
     }
     VisionJob& job = vision.prepare(frame);
     const auto prediction = predictor.predict(exposure);
@@ -186,6 +211,13 @@ struct OnboardLoop::Impl {
     job.detect_near = job.orient_like_predicted = job.detect && have_pose;
     job.up_cam.reset();
     job.up_obj.reset();
+    job.carried_cam_R_obj.reset();
+    if (job.detect && have_pose) {
+      if (const auto c = carried.at(exposure)) {
+        job.carried_cam_R_obj = c->cam_R_obj;
+        job.turn_tolerance_deg = fusion::carried_turn_tolerance_deg(*c);
+      }
+    }
     if (job.detect) {
       // With the down learnt while tracking, the search keeps only poses upright as the object
       // stands, and a prediction that itself tilts the object away (after an IMU gap) is no place
@@ -248,6 +280,7 @@ struct OnboardLoop::Impl {
       vision_only.restart(r->exposure_t_s, report.cam_T_obj);
       init_t_s = r->exposure_t_s;
       init_pending = true;
+      init_given = false;
       have_pose = true;
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
@@ -266,6 +299,7 @@ struct OnboardLoop::Impl {
       // Before, the start pose was offered again with every frame and refused each time
       // (vision_rejected counted every frame of every sim-run).
       if (fusion::supersedes_start_pose(v)) init_pending = false;
+      if (v == fusion::VisionVerdict::Applied || v == fusion::VisionVerdict::Initialised) carry(r->exposure_t_s);
       target = target_from_pose(r->exposure_t_s, report.cam_T_obj, target_point_obj);
       target_exposure_t_s = r->exposure_t_s;
       target_publish_t_s = published;
@@ -276,6 +310,7 @@ struct OnboardLoop::Impl {
   void count_acquisition(const VisionResult& r, vision::TrackStatus status, bool against_gravity) {
     if (r.detection) {
       ++summary.detections;
+      summary.found_turned_away_from_carried += r.turned_away;
       summary.detect_ms_max = std::max(summary.detect_ms_max, r.track_ms);
       if (r.found && !against_gravity) {
         ++summary.detections_found;
@@ -428,6 +463,7 @@ void OnboardLoop::set_initial_pose(double t_s, const Eigen::Isometry3d& cam_T_ob
   impl_->vision_only.restart(t_s, cam_T_obj);
   impl_->init_t_s = t_s;
   impl_->init_pending = true;
+  impl_->init_given = true;
   impl_->have_pose = true;
 }
 

@@ -2,11 +2,14 @@
 
 #include <chrono>
 #include <cstring>
+#include <numbers>
 
 #include <opencv2/imgproc.hpp>
 
 #include "epichead/geometry/level_to_up.h"
 #include "epichead/vision/model_centre.h"
+#include "epichead/vision/model_symmetry.h"
+#include "epichead/vision/revolution_axis.h"
 
 namespace epichead::head {
 
@@ -29,7 +32,10 @@ VisionStage::VisionStage(const vision::CadModel& model, const vision::Camera& ca
       centre_obj_(vision::model_centre(model)),
       threads_(threads),
       processing_s_(processing_s),
-      clock_(clock) {}
+      clock_(clock) {
+  symmetries_ = vision::model_symmetries(model);
+  if (const auto axis = vision::find_revolution_axis(model)) free_axis_obj_ = axis->direction_obj.normalized();
+}
 
 VisionStage::~VisionStage() { stop(); }
 
@@ -86,6 +92,9 @@ void VisionStage::detect_job(const cv::Mat& mat) {
   if (job_.orient_like_predicted) prior.orient_like = job_.predicted;
   prior.up_cam = job_.up_cam;
   prior.up_obj = job_.up_obj;
+  prior.cam_R_obj = job_.carried_cam_R_obj;
+  prior.turn_tolerance_deg = job_.turn_tolerance_deg;
+  result_.turned_away = false;
   const auto r = detector_->detect(mat, prior);
   result_.found = r && r->found;
   if (!result_.found) {
@@ -106,6 +115,18 @@ void VisionStage::detect_job(const cv::Mat& mat) {
   tracker_.track(image_, start, report_);
   report_.reasons = report_.reasons | vision::TrackReason::Reacquired;
   result_.predicted = start;
+  // Found turned as the gyro carried it, the tracker can still turn it onto clutter beside the
+  // object (as in `track`, tools/track_acquisition.cpp): then it is not found.
+  if (job_.carried_cam_R_obj && report_.status != vision::TrackStatus::Lost &&
+      vision::symmetric_turn_rad(report_.cam_T_obj.linear(), *job_.carried_cam_R_obj, symmetries_, free_axis_obj_) * 180 / std::numbers::pi >
+          job_.turn_tolerance_deg) {
+    result_.found = false;
+    result_.turned_away = true;
+    tracker_.reset();
+    report_.status = vision::TrackStatus::Lost;
+    report_.reasons = vision::TrackReason::Reacquired | vision::TrackReason::AgainstCarriedTurn;
+    report_.cam_T_obj = job_.predicted;
+  }
 }
 
 void VisionStage::submit(double now_s) {

@@ -51,6 +51,11 @@ struct VisionJob {
   // The world's up in the camera frame and the object's in its own (both known: the detection
   // keeps only poses that agree with them).
   std::optional<Eigen::Vector3d> up_cam, up_obj;
+  // The object's orientation the gyro carried since the filter last knew it (fusion/
+  // carried_orientation.h), and how far a found pose may be turned from it: the detection keeps
+  // only poses turned so, and refuses one the tracker then turns away.
+  std::optional<Eigen::Matrix3d> carried_cam_R_obj;
+  double turn_tolerance_deg = 0;
 };
 
 // What the stage gives back; valid from poll() until release().
@@ -67,6 +72,7 @@ struct VisionResult {
   bool detection = false;  // the job was a detection (found: the report is the tracking step from its pose)
   bool found = false;
   bool levelled = false;   // found with the ups known: the pose was levelled to them before tracking
+  bool turned_away = false;  // found turned as carried, but tracked turned away from it: not found
 };
 
 class VisionStage {
@@ -107,6 +113,10 @@ class VisionStage {
   void detect_job(const cv::Mat& mat);
   vision::ModelTracker tracker_;
   Eigen::Vector3d centre_obj_;  // vision::model_centre: a levelled detection turns about it
+  // For the carried orientation's test (vision::symmetric_turn_rad): the model's symmetries and a
+  // body of revolution's axis.
+  std::vector<Eigen::Isometry3d> symmetries_;
+  std::optional<Eigen::Vector3d> free_axis_obj_;
   vision::Detector* detector_ = nullptr;
   double detection_processing_s_ = 0.3;
   VisionThreads threads_;

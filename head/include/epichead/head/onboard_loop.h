@@ -142,6 +142,9 @@ struct OnboardSummary {
   // lost results) and re-acquisitions by detection; when detection first found the object.
   std::uint64_t detections = 0, detections_found = 0, losses = 0, reacquisitions = 0;
   std::uint64_t levelled_to_gravity = 0;  // found poses levelled to the measured up (down learnt)
+  // Found turned as the gyro carried the object's orientation, then tracked turned away from it:
+  // not taken (fusion/carried_orientation.h).
+  std::uint64_t found_turned_away_from_carried = 0;
   std::uint64_t against_gravity = 0;  // poses (tracked or detected) refused as wrong locks: their tilt
   double first_detection_t_s = -1;
   double detect_ms_max = 0;
