@@ -436,21 +436,8 @@ class ImuPredictor final : public TrackPredictor {
     if (const auto x = predictor_.state()) gyro_bias_radps_ = x->gyro_bias_radps;
     last_good_turned_.set(t_s, cam_T_obj.linear(), 0, gyro_bias_radps_);
   }
-  // The filter's orientation at t_s (just updated) is what the gyro carries from here: its 1-sigma
-  // the largest of its rotation block's, without a body of revolution's free turn, which no
-  // outline can contradict (vision::symmetric_turn_rad leaves it out too).
-  void carry(double t_s) {
-    const auto p = predictor_.predict(t_s);
-    const auto x = predictor_.state();
-    if (!p || !x) return;
-    Eigen::Matrix3d P = p->covariance.bottomRightCorner<3, 3>();
-    if (const auto& axis = options_.gravity_check.free_turn_axis_obj) {
-      const Eigen::Vector3d a = (p->cam_T_obj.linear() * *axis).normalized();
-      const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
-      P = across * P * across;
-    }
-    carried_.set(t_s, p->cam_T_obj.linear(), std::sqrt(std::max(0.0, P.diagonal().maxCoeff())), x->gyro_bias_radps);
-  }
+  // The filter's orientation at t_s (just updated) is what the gyro carries from here.
+  void carry(double t_s) { carried_.set_from(predictor_, t_s); }
   fusion::PredictorOptions options_;
   fusion::Predictor predictor_;
   const std::vector<vision::ImuRecord>* imu_;

@@ -1,7 +1,9 @@
 #include "epichead/fusion/carried_orientation.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "epichead/fusion/predictor.h"
 #include "epichead/geometry/so3.h"
 
 namespace epichead::fusion {
@@ -20,6 +22,21 @@ void CarriedOrientation::set(double t_s, const Eigen::Matrix3d& cam_R_obj, doubl
   turned_rad_ = 0;
   // Readings from here on turn it; the one at t_s is the start of the next step.
   if (!have_last_ || last_t_s_ < t_s) last_t_s_ = t_s;
+}
+
+void CarriedOrientation::set_from(const Predictor& filter, double t_s) {
+  const auto& free_axis_obj = filter.options().gravity_check.free_turn_axis_obj;
+  const auto p = filter.predict(t_s);
+  const auto x = filter.state();
+  if (!p || !x) return;
+  Eigen::Matrix3d P = p->covariance.bottomRightCorner<3, 3>();  // (translation, rotation): the rotation's
+  if (free_axis_obj) {
+    // The covariance is of a perturbation in the camera frame: the axis turned there.
+    const Eigen::Vector3d a = (p->cam_T_obj.linear() * *free_axis_obj).normalized();
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
+    P = across * P * across;
+  }
+  set(t_s, p->cam_T_obj.linear(), std::sqrt(std::max(0.0, P.diagonal().maxCoeff())), x->gyro_bias_radps);
 }
 
 void CarriedOrientation::add_gyro(double t_s, const Eigen::Vector3d& gyro_radps) {

@@ -49,9 +49,7 @@ struct OnboardLoop::Impl {
         vision(m, cam, o.tracker, o.threads, o.processing_s, *p.clock), predictor(std::move(pred)),
         arbiter(o.predictor.gate_chi2),
         controller(std::move(ctrl)), target_point_obj(vision::model_centre(m)), imu_clock(clock_sync_options(o)),
-        recorder(std::move(rec)), carried(o.predictor.mount.cam_R_imu, fusion::CarriedOrientationNoise{}) {
-    if (const auto axis = vision::find_revolution_axis(m)) free_axis_obj = axis->direction_obj.normalized();
-  }
+        recorder(std::move(rec)), carried(o.predictor.mount.cam_R_imu, fusion::CarriedOrientationNoise{}) {}
 
   const vision::CadModel* model;
   vision::Camera camera;
@@ -69,7 +67,6 @@ struct OnboardLoop::Impl {
   // The object's orientation the gyro carries from the filter's last applied pose (or the start
   // pose given): detection after a loss looks for the object turned so (as `track` does).
   fusion::CarriedOrientation carried;
-  std::optional<Eigen::Vector3d> free_axis_obj;  // a body of revolution's: its turn is not carried
   bool init_given = false;  // the pending start pose is the user's (set_initial_pose), not a detection's
 
   // Initial pose and the last good one: where windows go while the predictor has nothing.
@@ -157,20 +154,8 @@ struct OnboardLoop::Impl {
     if (v == fusion::ImuVerdict::Accepted || v == fusion::ImuVerdict::Buffered) carried.add_gyro(s.t_s, s.gyro_radps);
   }
 
-  // The filter's orientation at t_s (just updated) is what the gyro carries from here; its 1-sigma
-  // the largest of its rotation block's, without a body of revolution's free turn.
-  void carry(double t_s) {
-    const auto p = predictor.predict(t_s);
-    const auto x = predictor.state();
-    if (!p || !x) return;
-    Eigen::Matrix3d P = p->covariance.bottomRightCorner<3, 3>();
-    if (free_axis_obj) {
-      const Eigen::Vector3d a = (p->cam_T_obj.linear() * *free_axis_obj).normalized();
-      const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
-      P = across * P * across;
-    }
-    carried.set(t_s, p->cam_T_obj.linear(), std::sqrt(std::max(0.0, P.diagonal().maxCoeff())), x->gyro_bias_radps);
-  }
+  // The filter's orientation at t_s (just updated) is what the gyro carries from here.
+  void carry(double t_s) { carried.set_from(predictor, t_s); }
 
   // A new camera frame, if one is ready: to the vision stage with the pose predicted at its
   // exposure, or dropped (counted) while the stage is busy with an earlier one.

@@ -13,6 +13,8 @@
 
 namespace epichead::fusion {
 
+class Predictor;
+
 struct CarriedOrientationNoise {
   // 1-sigma of the gyro bias left after the filter's estimate, rad/s (0.3 deg/s).
   double bias_sigma_radps = 0.005;
@@ -41,6 +43,11 @@ class CarriedOrientation {
   // The filter knew the orientation at t_s (camera clock) to sigma_rad, with this gyro bias.
   // Samples up to t_s are taken as already in it.
   void set(double t_s, const Eigen::Matrix3d& cam_R_obj, double sigma_rad, const Eigen::Vector3d& gyro_bias_radps);
+  // The filter's orientation at t_s (just updated) and its gyro bias; the 1-sigma the largest of
+  // its rotation block's, without a body of revolution's free turn (the filter's
+  // gravity_check.free_turn_axis_obj), which no outline can contradict. Nothing happens before the
+  // filter starts.
+  void set_from(const Predictor& filter, double t_s);
   // One gyro reading at t_s (camera clock). A reading at or before the newest one taken (a clock
   // restart feeding samples again), or not finite, is skipped.
   void add_gyro(double t_s, const Eigen::Vector3d& gyro_radps);
