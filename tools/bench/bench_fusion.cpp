@@ -1,13 +1,15 @@
 // Benchmarks of the Kalman predictor (issue 7): imu_step (one 1 kHz sample: propagation of the
 // state and its 17x17 covariance, stored in the ring), imu_step_unaided (a sample that also
 // carries the unaided tilt update over 0.4 s of samples and the position hold, unaided_update.h;
-// one in 200 does without vision) and vision_update (a pose 100 ms late:
-// the update at its exposure time and 100 samples of re-propagation). A still camera: the
-// arithmetic per sample does not depend on the motion.
+// one in 200 does without vision), vision_update (a pose 100 ms late: the update at its exposure
+// time and 100 samples of re-propagation) and carried_orientation_step (one gyro sample turning
+// the orientation carried across a loss, fusion/carried_orientation.h, which the onboard loop adds
+// to each sample). A still camera: the arithmetic per sample does not depend on the motion.
 #include <memory>
 #include <stdexcept>
 
 #include "bench/bench.h"
+#include "epichead/fusion/carried_orientation.h"
 #include "epichead/fusion/predictor.h"
 #include "epichead/geometry/so3.h"
 
@@ -93,6 +95,16 @@ const Registration vision_update{"vision_update", [] {
       if (b->predictor->add_imu(b->sample) != ImuVerdict::Accepted) ++b->rejected;
     }
     if (b->predictor->add_vision(*exposure_t_s, b->cam_T_obj, b->cov).verdict != VisionVerdict::Applied) ++b->rejected;
+  };
+}};
+
+const Registration carried_orientation_step{"carried_orientation_step", [] {
+  auto carried = std::make_shared<CarriedOrientation>(Eigen::Matrix3d::Identity(), CarriedOrientationNoise{});
+  carried->set(0.0, geometry::so3_exp(Eigen::Vector3d(0.2, -0.3, 0.1)), 0.01, Eigen::Vector3d(1e-3, 0, 0));
+  auto t_s = std::make_shared<double>(0.0);
+  return [carried, t_s] {
+    *t_s += 1e-3;
+    carried->add_gyro(*t_s, Eigen::Vector3d(0.3, -0.2, 0.1));
   };
 }};
 
