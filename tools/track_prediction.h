@@ -1,7 +1,7 @@
 #pragma once
 // Where `epichead track` places each frame's windows: the pose predicted at the frame's time,
 // from the IMU (--imu on) or from a constant-velocity model of the tracked poses (--imu off).
-// After a loss the prediction restarts from the last good pose.
+// After a long loss the prediction is the last good pose turned as the gyro turned the camera.
 #include <expected>
 #include <memory>
 #include <optional>
@@ -90,7 +90,7 @@ class TrackPredictor {
     return false;
   }
   // ... and the filter has forgotten its state after a long loss, so nothing else judges the pose:
-  // a re-lock on clutter from a stale prediction, to be taken as lost. Counted.
+  // a re-lock from the prediction onto clutter, to be taken as lost. Counted.
   virtual bool against_carried_turn(double t_s, const Eigen::Isometry3d& cam_T_obj) {
     (void)t_s;
     (void)cam_T_obj;
