@@ -1,7 +1,8 @@
 #pragma once
 // Where `epichead track` places each frame's windows: the pose predicted at the frame's time,
 // from the IMU (--imu on) or from a constant-velocity model of the tracked poses (--imu off).
-// After a long loss the prediction is the last good pose turned as the gyro turned the camera.
+// After a loss the prediction restarts from the last good pose (with the IMU, after a long loss,
+// turned as the gyro turned the camera).
 #include <expected>
 #include <memory>
 #include <optional>
