@@ -203,8 +203,13 @@ class ImuPredictor final : public TrackPredictor {
     reset_done_ = false;
     if (estimator_ && !adopted_) {
       estimator_->add_pose(t_s, report.cam_T_obj);
-      // A fit costs about a millisecond: try a few times a second, not every frame.
-      if (++frames_since_fit_ >= kFitEveryFrames) {
+      // A fit costs about a millisecond: try a few times a second, not every frame. Not on a
+      // frame re-locked after a loss or doubtful: the filter restarts from this frame's pose on
+      // the new clock, and such a pose may be a wrong lock (fresh held-out stumble 294: re-locked
+      // 50 deg off as the estimate became confident; the filter and the orientation carried from
+      // it followed the lock). The next frame is tried instead.
+      const bool settled = report.status == vision::TrackStatus::Tracked && !vision::has(report.reasons, vision::TrackReason::Reacquired);
+      if (++frames_since_fit_ >= kFitEveryFrames && settled) {
         frames_since_fit_ = 0;
         if (const auto e = estimator_->estimate()) {
           const fusion::VisionResult adopted = adopt(*e, t_s, report);
