@@ -25,7 +25,7 @@ double turn_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 
 }  // namespace
 
-TEST_CASE("detection told the object's turn finds it; told a turn 60 deg away it does not report it") {
+TEST_CASE("detection told the object's turn finds it, and told a turn 60 deg away does not report it") {
   TempDir tmp("epichead_test_detect_turn_prior");
   const std::string dir = tmp / "box_clutter";
   REQUIRE(run_epichead(tmp, "sim box_clutter --seed 1 --frames 1 --out " + epichead::testing::shell_quoted(dir)).exit_code == 0);
