@@ -12,6 +12,8 @@
 # With --system (root, on a machine you may change: a container, a VM, a fresh install) the
 # package is installed for real with apt-get, the checks run against /usr, and it is purged at
 # the end. It refuses to run when epichead is already installed. Not part of ./dev test.
+# What it built and unpacked (about 1 GB with the sanitizers) is removed once it passes; the logs
+# stay in WORK_DIR. A failing run leaves everything there to look at.
 # Usage: tests/install/install_test.sh [--deb|--system] BUILD_DIR WORK_DIR SEQUENCE_DIR [CXXFLAGS [PYTHON_PRELOAD]]
 #   CXXFLAGS: the flags the build tree's libraries need in a consumer (the sanitizers)
 #   PYTHON_PRELOAD: LD_PRELOAD for python3 importing a sanitized module (the ASan runtime)
@@ -38,6 +40,8 @@ if ((deb)); then
   (cd "$build" && cpack -G DEB -B "$work/package") > "$work/cpack.log" 2>&1 || { cat "$work/cpack.log" >&2; exit 1; }
   package=$(compgen -G "$work/package/epichead_*.deb" | head -1 || true)
   [[ -n "$package" ]] || { echo "install_test: cpack made no epichead_*.deb in $work/package" >&2; exit 1; }
+  # CPack's staging tree is a second copy of the installation: only the .deb is used from here on.
+  rm -rf "$work/package/_CPack_Packages"
   dpkg-deb --field "$package" Package Version Depends > "$work/fields.txt"
   grep -q '^Package: epichead$' "$work/fields.txt" || { echo "install_test: $package is not named epichead" >&2; exit 1; }
   deb_version=$(sed -n 's/^Version: //p' "$work/fields.txt")
@@ -69,6 +73,7 @@ if ((deb)); then
     prefix=/usr
   else
     dpkg-deb -x "$package" "$work/root"
+    rm -f "$package"
     prefix="$work/root/usr"
   fi
 else
@@ -137,4 +142,11 @@ program_version=$("$prefix/bin/epichead" --version)
 if ((deb)); then
   [[ "$deb_version" == "$version" ]] || { echo "install_test: the package says version '$deb_version', pkg-config '$version'" >&2; exit 1; }
 fi
-step "ok (version $version)"
+cd /
+if ((system)); then
+  rm -rf "$work/package"
+else
+  rm -rf "${prefix%/usr}" "$work/package"
+fi
+rm -rf "$work/cmake-consumer" "$work/pc-consumer" "$work/sim"
+step "ok (version $version; what it installed and built is removed, the logs are in $work)"

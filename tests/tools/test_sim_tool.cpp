@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "epichead/vision/offline/sequence.h"
 
 namespace fs = std::filesystem;
@@ -20,14 +21,10 @@ struct Run {
   std::string out, err;
 };
 
+// One folder for the test process, removed when it ends.
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("epichead_test_sim_tool_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+  static const epichead::testing::TempDir dir("epichead_test_sim_tool");
+  return dir.path;
 }
 
 std::string slurp(const fs::path& p) {
